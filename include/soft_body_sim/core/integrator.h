@@ -1,0 +1,45 @@
+// Time integrators. Each advances the same physical model (springs, dashpots, gravity, drag,
+// distance constraints) by one (sub)step h, so that their results can be compared.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+enum class IntegratorType
+{
+  ExplicitEuler,
+  SemiImplicitEuler,
+  Verlet,
+  VelocityVerlet,
+  Rk4,
+  ImplicitEuler,
+  Xpbd,
+};
+
+/// The scene-file name of each integrator, e.g. "semi_implicit_euler".
+std::string integratorName(IntegratorType type);
+/// Parses a scene-file name; false if the name is unknown.
+bool integratorFromName(const std::string& name, IntegratorType& type);
+/// Every valid name, in declaration order.
+const std::vector<std::string>& integratorNames();
+
+class Integrator
+{
+public:
+  virtual ~Integrator() = default;
+  /// Advances `state` by h [s]. Pinned nodes (inverse mass 0) are never moved: their position and
+  /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
+  virtual void step(const Model& model, State& state, double h, int iterations) = 0;
+  /// Forgets any history (previous positions, cached accelerations); call after the state was changed
+  /// from outside, e.g. a reset or a teleported node.
+  virtual void restart() {}
+};
+
+std::unique_ptr<Integrator> makeIntegrator(IntegratorType type);
+
+}  // namespace soft_body_sim

@@ -1,0 +1,77 @@
+// The physical model of a scene: what it *is* (topology, parameters), apart from where it is now.
+// Header of the ROS-free core: Eigen and the standard library only.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace soft_body_sim
+{
+/// A point or direction in the scene's fixed frame [m].
+using Vec3 = Eigen::Vector3d;
+/// One column per node: positions [m], velocities [m/s], accelerations [m/s^2] or forces [N].
+using NodeArray = Eigen::Matrix3Xd;
+
+/// Hooke spring with a dashpot on the relative velocity along the spring:
+/// F_a = (-k (|d| - rest_length) - c ((v_a - v_b) . u)) u,  F_b = -F_a,  d = x_a - x_b,  u = d / |d|.
+struct Spring
+{
+  int a = 0;
+  int b = 0;
+  double rest_length = 0.0;  ///< [m]
+  double stiffness = 0.0;    ///< k [N/m], > 0
+  double damping = 0.0;      ///< c [N s/m], >= 0
+};
+
+/// Distance constraint C = |x_a - x_b| - rest_length, solved by projection (XPBD, Macklin et al. 2016).
+/// compliance 0 is inextensible; compliance alpha behaves like a spring of stiffness 1/alpha.
+struct DistanceConstraint
+{
+  int a = 0;
+  int b = 0;
+  double rest_length = 0.0;  ///< [m]
+  double compliance = 0.0;   ///< alpha [m/N], >= 0
+};
+
+/// A named run of consecutive nodes: the scene's bodies share one node array.
+struct BodyRange
+{
+  std::string name;
+  int first = 0;
+  int count = 0;
+};
+
+/// Everything that stays fixed while a scene runs. Pinned node = inverse mass 0: no force moves it;
+/// only the caller (an anchor) does.
+struct Model
+{
+  Eigen::VectorXd mass;          ///< [kg] per node (kept for pinned nodes too, for reporting)
+  Eigen::VectorXd inverse_mass;  ///< [1/kg] per node, 0 for pinned nodes
+  std::vector<Spring> springs;
+  std::vector<DistanceConstraint> constraints;
+  std::vector<BodyRange> bodies;
+  Vec3 gravity = Vec3(0.0, 0.0, -9.81);  ///< [m/s^2]
+  double drag = 0.0;                      ///< linear air drag [1/s]: a -= drag * v on free nodes
+
+  int nodeCount() const { return static_cast<int>(mass.size()); }
+  bool isFree(int i) const { return inverse_mass[i] > 0.0; }
+};
+
+/// Where the scene is now.
+struct State
+{
+  NodeArray position;  ///< [m]
+  NodeArray velocity;  ///< [m/s]
+};
+
+/// How a step is taken: the world advances dt per step in `substeps` equal sub-steps.
+struct StepSettings
+{
+  double dt = 0.001;   ///< [s] fixed physics step, > 0
+  int substeps = 1;    ///< sub-steps per step, >= 1
+  int iterations = 1;  ///< constraint/relaxation iterations (implicit_euler: Newton iterations), >= 1
+};
+
+}  // namespace soft_body_sim

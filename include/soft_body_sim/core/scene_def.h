@@ -1,0 +1,68 @@
+// A scene as plain structs with defaults: what the YAML loader fills and what tests build directly.
+// ROS-free and YAML-free; buildWorld() turns it into a running World.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "soft_body_sim/core/integrator.h"
+#include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/world.h"
+
+namespace soft_body_sim
+{
+struct NodeDef
+{
+  Vec3 position = Vec3::Zero();  ///< [m]
+  double mass = 1.0;             ///< [kg], > 0
+  Vec3 velocity = Vec3::Zero();  ///< [m/s]
+  bool pinned = false;           ///< pinned nodes have inverse mass 0
+};
+
+struct SpringDef
+{
+  int a = 0;  ///< node index within the body
+  int b = 0;
+  double stiffness = 0.0;                ///< [N/m], > 0
+  double damping = 0.0;                  ///< [N s/m], >= 0
+  std::optional<double> rest_length;     ///< [m]; default: the initial distance
+};
+
+struct ConstraintDef
+{
+  int a = 0;  ///< node index within the body
+  int b = 0;
+  double compliance = 0.0;               ///< [m/N], >= 0 (0 = inextensible)
+  std::optional<double> rest_length;     ///< [m]; default: the initial distance
+};
+
+struct BodyDef
+{
+  std::string name;
+  std::string type = "custom";
+  std::vector<NodeDef> nodes;
+  std::vector<SpringDef> springs;
+  std::vector<ConstraintDef> constraints;
+};
+
+struct PhysicsDef
+{
+  IntegratorType integrator = IntegratorType::SemiImplicitEuler;
+  StepSettings step;                        ///< dt [s], substeps, iterations
+  Vec3 gravity = Vec3(0.0, 0.0, -9.81);     ///< [m/s^2]
+  double drag = 0.0;                        ///< [1/s]
+};
+
+struct SceneDef
+{
+  std::string frame_id = "world";  ///< fixed frame of the simulation
+  PhysicsDef physics;
+  std::vector<BodyDef> bodies;
+};
+
+/// Flattens the bodies into one node array (body k's nodes follow body k-1's) and returns the world.
+/// Expects a valid scene (the loader checks); throws std::invalid_argument on an index out of range.
+World buildWorld(const SceneDef& scene);
+
+}  // namespace soft_body_sim

@@ -1,0 +1,65 @@
+#include "soft_body_sim/core/integrator.h"
+
+#include <stdexcept>
+
+#include "integrators/integrator_kit.h"
+
+namespace soft_body_sim
+{
+namespace
+{
+struct Entry
+{
+  IntegratorType type;
+  const char* name;
+  std::unique_ptr<Integrator> (*make)();
+};
+
+const Entry kEntries[] = {
+  { IntegratorType::ExplicitEuler, "explicit_euler", makeExplicitEuler },
+  { IntegratorType::SemiImplicitEuler, "semi_implicit_euler", makeSemiImplicitEuler },
+  { IntegratorType::Verlet, "verlet", makeVerlet },
+  { IntegratorType::VelocityVerlet, "velocity_verlet", makeVelocityVerlet },
+  { IntegratorType::Rk4, "rk4", makeRk4 },
+  { IntegratorType::ImplicitEuler, "implicit_euler", makeImplicitEuler },
+  { IntegratorType::Xpbd, "xpbd", makeXpbd },
+};
+
+const Entry& entry(IntegratorType type)
+{
+  for (const Entry& e : kEntries)
+    if (e.type == type)
+      return e;
+  throw std::logic_error("integrator type without an entry");
+}
+}  // namespace
+
+std::string integratorName(IntegratorType type) { return entry(type).name; }
+
+bool integratorFromName(const std::string& name, IntegratorType& type)
+{
+  for (const Entry& e : kEntries)
+  {
+    if (name == e.name)
+    {
+      type = e.type;
+      return true;
+    }
+  }
+  return false;
+}
+
+const std::vector<std::string>& integratorNames()
+{
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> all;
+    for (const Entry& e : kEntries)
+      all.emplace_back(e.name);
+    return all;
+  }();
+  return names;
+}
+
+std::unique_ptr<Integrator> makeIntegrator(IntegratorType type) { return entry(type).make(); }
+
+}  // namespace soft_body_sim

@@ -1,0 +1,134 @@
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCore>
+
+#include "integrator_kit.h"
+#include "soft_body_sim/core/forces.h"
+
+namespace soft_body_sim
+{
+namespace
+{
+using Matrix3 = Eigen::Matrix3d;
+
+/// Backward Euler, v_{n+1} = v_n + h M^-1 f(x_n + h v_{n+1}, v_{n+1}), x_{n+1} = x_n + h v_{n+1},
+/// solved by Newton's method as in Baraff & Witkin 1998 ("Large steps in cloth simulation"):
+/// each iteration linearises f about (x_lin, v_k) and solves
+///   (M - h D - h^2 K) dv = h f(x_lin, v_k) + h K (x_n + h v_k - x_lin) - M (v_k - v_n)
+/// with K = df/dx, D = df/dv, by sparse conjugate gradients. The first iteration linearises at
+/// x_lin = x_n (exactly Baraff & Witkin's step); later ones at x_lin = x_n + h v_k.
+/// K's transverse term k (1 - L/l)(I - u u^T) is dropped when the spring is compressed (Choi & Ko
+/// 2002) so that the matrix stays symmetric positive definite; the damping force's dependence on x is
+/// neglected, as in Baraff & Witkin. Unconditionally stable on a linear spring; first order.
+class ImplicitEuler final : public Integrator
+{
+public:
+  void step(const Model& model, State& state, double h, int iterations) override
+  {
+    const int n = model.nodeCount();
+    start_x_ = state.position;
+    start_v_ = state.velocity;
+    for (int k = 0; k < iterations; ++k)
+    {
+      const NodeArray& v_k = state.velocity;
+      // x_lin and the offset x_n + h v_k - x_lin at which K acts (nonzero only on the first iteration).
+      linear_x_ = start_x_;
+      offset_.setZero(3, n);
+      for (int i = 0; i < n; ++i)
+      {
+        if (!model.isFree(i))
+          continue;
+        if (k == 0)
+          offset_.col(i) = h * v_k.col(i);
+        else
+          linear_x_.col(i) += h * v_k.col(i);
+      }
+      assemble(model, linear_x_, v_k, h);
+      solver_.compute(matrix_);
+      delta_v_ = solver_.solve(rhs_);
+      for (int i = 0; i < n; ++i)
+        if (model.isFree(i))
+          state.velocity.col(i) += delta_v_.segment<3>(3 * i);
+    }
+    for (int i = 0; i < n; ++i)
+      if (model.isFree(i))
+        state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
+    constraints_.apply(model, state, h, iterations);
+  }
+
+private:
+  /// Fills matrix_ = M - h D - h^2 K and rhs_ (see the class comment) at (x, v).
+  void assemble(const Model& model, const NodeArray& x, const NodeArray& v, double h)
+  {
+    const int n = model.nodeCount();
+    force_.setZero(3, n);
+    accumulateSpringForces(model, x, v, force_);
+    triplets_.clear();
+    rhs_.resize(3 * n);
+    for (int i = 0; i < n; ++i)
+    {
+      if (!model.isFree(i))
+      {
+        // Pinned: dv = 0, an identity row.
+        rhs_.segment<3>(3 * i).setZero();
+        addBlock(i, i, Matrix3::Identity());
+        continue;
+      }
+      const double m = model.mass[i];
+      const Vec3 f = force_.col(i) + m * model.gravity - m * model.drag * v.col(i);
+      rhs_.segment<3>(3 * i) = h * f - m * (v.col(i) - start_v_.col(i));
+      addBlock(i, i, (m * (1.0 + h * model.drag)) * Matrix3::Identity());
+    }
+    for (const Spring& s : model.springs)
+    {
+      const Vec3 d = x.col(s.a) - x.col(s.b);
+      const double length = d.norm();
+      if (length < kMinSpringLength)
+        continue;
+      const Vec3 u = d / length;
+      const Matrix3 uu = u * u.transpose();
+      const double transverse = std::max(0.0, 1.0 - s.rest_length / length);
+      // -df_a/dx_a of the spring (clamped, see above) and -df_a/dv_a of its dashpot.
+      const Matrix3 stiffness = s.stiffness * (uu + transverse * (Matrix3::Identity() - uu));
+      const Matrix3 block = h * h * stiffness + h * s.damping * uu;
+      const Vec3 k_offset = -stiffness * (offset_.col(s.a) - offset_.col(s.b));
+      const bool a_free = model.isFree(s.a);
+      const bool b_free = model.isFree(s.b);
+      if (a_free)
+      {
+        rhs_.segment<3>(3 * s.a) += h * k_offset;
+        addBlock(s.a, s.a, block);
+      }
+      if (b_free)
+      {
+        rhs_.segment<3>(3 * s.b) -= h * k_offset;
+        addBlock(s.b, s.b, block);
+      }
+      if (a_free && b_free)
+      {
+        addBlock(s.a, s.b, -block);
+        addBlock(s.b, s.a, -block);
+      }
+    }
+    matrix_.resize(3 * n, 3 * n);
+    matrix_.setFromTriplets(triplets_.begin(), triplets_.end());
+  }
+
+  void addBlock(int row, int col, const Matrix3& block)
+  {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c)
+        triplets_.emplace_back(3 * row + r, 3 * col + c, block(r, c));
+  }
+
+  NodeArray start_x_, start_v_, linear_x_, offset_, force_;
+  std::vector<Eigen::Triplet<double>> triplets_;
+  Eigen::SparseMatrix<double> matrix_;
+  Eigen::VectorXd rhs_, delta_v_;
+  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver_;
+  ConstraintPass constraints_;
+};
+}  // namespace
+
+std::unique_ptr<Integrator> makeImplicitEuler() { return std::make_unique<ImplicitEuler>(); }
+
+}  // namespace soft_body_sim

@@ -1,0 +1,67 @@
+#include "soft_body_sim/core/scene_def.h"
+
+#include <stdexcept>
+
+namespace soft_body_sim
+{
+namespace
+{
+int globalIndex(const BodyDef& body, int first, int local)
+{
+  if (local < 0 || local >= static_cast<int>(body.nodes.size()))
+    throw std::invalid_argument("body '" + body.name + "': node index " + std::to_string(local) + " out of range");
+  return first + local;
+}
+
+double restLengthOr(const std::optional<double>& rest_length, const State& state, int a, int b)
+{
+  return rest_length ? *rest_length : (state.position.col(a) - state.position.col(b)).norm();
+}
+}  // namespace
+
+World buildWorld(const SceneDef& scene)
+{
+  int node_count = 0;
+  for (const BodyDef& body : scene.bodies)
+    node_count += static_cast<int>(body.nodes.size());
+
+  Model model;
+  model.gravity = scene.physics.gravity;
+  model.drag = scene.physics.drag;
+  model.mass.resize(node_count);
+  model.inverse_mass.resize(node_count);
+  State state;
+  state.position.resize(3, node_count);
+  state.velocity.resize(3, node_count);
+
+  int first = 0;
+  for (const BodyDef& body : scene.bodies)
+  {
+    const int count = static_cast<int>(body.nodes.size());
+    for (int k = 0; k < count; ++k)
+    {
+      const NodeDef& node = body.nodes[static_cast<std::size_t>(k)];
+      model.mass[first + k] = node.mass;
+      model.inverse_mass[first + k] = node.pinned ? 0.0 : 1.0 / node.mass;
+      state.position.col(first + k) = node.position;
+      state.velocity.col(first + k) = node.velocity;
+    }
+    for (const SpringDef& s : body.springs)
+    {
+      const int a = globalIndex(body, first, s.a);
+      const int b = globalIndex(body, first, s.b);
+      model.springs.push_back({ a, b, restLengthOr(s.rest_length, state, a, b), s.stiffness, s.damping });
+    }
+    for (const ConstraintDef& c : body.constraints)
+    {
+      const int a = globalIndex(body, first, c.a);
+      const int b = globalIndex(body, first, c.b);
+      model.constraints.push_back({ a, b, restLengthOr(c.rest_length, state, a, b), c.compliance });
+    }
+    model.bodies.push_back({ body.name, first, count });
+    first += count;
+  }
+  return World(std::move(model), std::move(state), scene.physics.integrator, scene.physics.step);
+}
+
+}  // namespace soft_body_sim
