@@ -1,0 +1,81 @@
+// Helpers shared by the core tests: small scenes built from plain structs, and Eigen comparisons.
+#pragma once
+
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "soft_body_sim/core/scene_def.h"
+
+namespace soft_body_sim::test
+{
+/// Asserts |a - b|_inf <= tol and prints both sides on failure.
+template <typename A, typename B>
+::testing::AssertionResult expectNear(const A& a, const B& b, double tol)
+{
+  const double error = (a - b).cwiseAbs().maxCoeff();
+  if (error <= tol)
+    return ::testing::AssertionSuccess();
+  Eigen::IOFormat format(Eigen::FullPrecision, 0, ", ", "; ", "", "", "[", "]");
+  return ::testing::AssertionFailure() << "\n  actual:   " << a.format(format) << "\n  expected: " << b.format(format)
+                                       << "\n  max |difference| " << error << " > tolerance " << tol;
+}
+
+inline bool allFinite(const State& state)
+{
+  return state.position.allFinite() && state.velocity.allFinite();
+}
+
+/// A scene with one custom body and no gravity.
+inline SceneDef oneBodyScene(IntegratorType integrator, double dt)
+{
+  SceneDef scene;
+  scene.physics.integrator = integrator;
+  scene.physics.step.dt = dt;
+  scene.physics.gravity = Vec3::Zero();
+  scene.bodies.push_back(BodyDef{ "body", "custom", {}, {}, {} });
+  return scene;
+}
+
+/// The damped harmonic oscillator: node 0 pinned at the origin, node 1 of mass m on a spring of
+/// stiffness k, rest length 1 m and dashpot c along x, plus air drag; starts displaced by x0 [m] from rest
+/// with velocity v0 [m/s]. Motion stays on the x axis, where the spring force is linear.
+struct Oscillator
+{
+  double mass = 1.0;                     ///< [kg]
+  double stiffness = 4.0 * M_PI * M_PI;  ///< [N/m]: w0 = 2 pi rad/s
+  double damping = 0.0;                  ///< [N s/m]
+  double drag = 0.0;                     ///< [1/s]
+  double x0 = 0.1;                       ///< [m]
+  double v0 = 0.0;                       ///< [m/s]
+  static constexpr double kRest = 1.0;   ///< [m]
+
+  double omega0() const { return std::sqrt(stiffness / mass); }
+
+  World world(IntegratorType integrator, double dt, int substeps = 1) const
+  {
+    SceneDef scene = oneBodyScene(integrator, dt);
+    scene.physics.drag = drag;
+    scene.physics.step.substeps = substeps;
+    BodyDef& body = scene.bodies[0];
+    body.nodes.push_back(NodeDef{ Vec3::Zero(), mass, Vec3::Zero(), true });
+    body.nodes.push_back(NodeDef{ Vec3(kRest + x0, 0, 0), mass, Vec3(v0, 0, 0), false });
+    body.springs.push_back(SpringDef{ 0, 1, stiffness, damping, kRest });
+    return buildWorld(scene);
+  }
+
+  /// Displacement from rest [m] of the moving node.
+  static double displacement(const World& world) { return world.state().position(0, 1) - kRest; }
+
+  /// Closed-form x(t) of m x'' + b x' + k x = 0 with b = c + m drag (underdamped).
+  double exact(double t) const
+  {
+    const double zeta_omega = (damping + mass * drag) / (2.0 * mass);
+    const double omega_d = std::sqrt(omega0() * omega0() - zeta_omega * zeta_omega);
+    return std::exp(-zeta_omega * t) *
+           (x0 * std::cos(omega_d * t) + (v0 + zeta_omega * x0) / omega_d * std::sin(omega_d * t));
+  }
+};
+
+}  // namespace soft_body_sim::test
