@@ -6,7 +6,9 @@ namespace
 {
 /// Extended position-based dynamics (Macklin, Mueller, Chentanez 2016), one call per sub-step as in
 /// "Small steps in physics simulation" (Macklin et al. 2019) and Ten Minute Physics:
-///   preSolve:  v += h g (drag taken implicitly: v = (v + h g) / (1 + h drag)),  x_prev = x,  x += h v
+///   preSolve:  v = v / (1 + h drag) + h g,  x_prev = x,  x += h v
+///              (drag implicit on the carried velocity only, so it stays stable for any h drag and
+///              cannot scale gravity down at rest, where the constraints cancel h g every sub-step)
 ///   solve:     `iterations` Gauss-Seidel sweeps over springs (compliance 1/k, damping c) and
 ///              distance constraints (their own compliance), lambda accumulated per sub-step
 ///   postSolve: v = (x - x_prev) / h
@@ -29,7 +31,7 @@ private:
     {
       if (!model.isFree(i))
         continue;
-      state.velocity.col(i) = (state.velocity.col(i) + h * model.gravity) * drag_factor;
+      state.velocity.col(i) = state.velocity.col(i) * drag_factor + h * model.gravity;
       state.position.col(i) += h * state.velocity.col(i);
     }
   }
