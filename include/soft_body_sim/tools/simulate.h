@@ -1,0 +1,19 @@
+// The headless simulator behind `scripts/simulate`: runs a scene file for a duration and writes node
+// positions as CSV. A library function so that its contract is unit-tested; the executable only calls it.
+#pragma once
+
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace soft_body_sim
+{
+/// Usage: simulate --scene FILE [--duration S] [--integrator NAME] [--dt S] [--substeps N]
+///                 [--iterations N] [--every K] [--csv FILE]
+/// Runs round(duration / dt) steps from t = 0 and writes `t,body,node,x,y,z` rows (17 significant
+/// digits) at t = 0, every K steps when --every is given, and after the last step; to `out` unless
+/// --csv names a file. Command-line values override the scene file's. On bad input writes one line to
+/// `err` and returns non-zero; returns 0 on success.
+int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+}  // namespace soft_body_sim

@@ -1,0 +1,44 @@
+# Sourced by the scripts in this folder: installs what is missing from Debian's packages and builds the
+# catkin package into build/ at the repository root. Idempotent and quick when everything is present.
+set -euo pipefail
+
+ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+BUILD="$ROOT/build"
+# Debian's ROS lives in /usr; a pyenv python3 first on PATH lacks catkin_pkg.
+export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
+
+# Everything the build and the tests use, from Debian 12's own packages.
+PACKAGES=(
+  build-essential cmake python3
+  catkin python3-catkin-pkg ros-message-generation ros-message-runtime
+  libstd-msgs-dev libgeometry-msgs-dev
+  libeigen3-dev libyaml-cpp-dev
+  googletest libgtest-dev
+)
+
+log() { printf '[%s] %s\n' "$(basename "$0")" "$*" >&2; }
+
+install_missing() {
+  local missing=() package
+  for package in "${PACKAGES[@]}"; do
+    dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
+  done
+  [ ${#missing[@]} -eq 0 ] && return 0
+  log "installing ${missing[*]}"
+  local sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >&2
+}
+
+# Configures (once) and builds; the full output goes to build/build.log, shown when the build fails.
+build_package() {
+  mkdir -p "$BUILD"
+  if [ ! -f "$BUILD/Makefile" ]; then
+    log "configuring into $BUILD"
+    cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
+      >"$BUILD/build.log" 2>&1 || { cat "$BUILD/build.log" >&2; return 1; }
+  fi
+  log "building"
+  make -C "$BUILD" -j"$(nproc)" "$@" >>"$BUILD/build.log" 2>&1 || { tail -n 60 "$BUILD/build.log" >&2; return 1; }
+}

@@ -1,0 +1,194 @@
+#include "soft_body_sim/tools/simulate.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <map>
+#include <optional>
+#include <stdexcept>
+
+#include "soft_body_sim/scene/scene_loader.h"
+
+namespace soft_body_sim
+{
+namespace
+{
+/// Bad command-line input; what() is the one-line reason.
+struct UsageError : std::runtime_error
+{
+  using std::runtime_error::runtime_error;
+};
+
+const char* const kUsage =
+    "usage: simulate --scene FILE [--duration S] [--integrator NAME] [--dt S] [--substeps N] "
+    "[--iterations N] [--every K] [--csv FILE]";
+
+struct Options
+{
+  std::string scene;
+  double duration = 1.0;  ///< [s]
+  std::optional<std::string> integrator;
+  std::optional<double> dt;
+  std::optional<int> substeps;
+  std::optional<int> iterations;
+  std::optional<long long> every;
+  std::optional<std::string> csv;
+};
+
+double parseNumber(const std::string& option, const std::string& text)
+{
+  std::size_t used = 0;
+  double value = 0.0;
+  try
+  {
+    value = std::stod(text, &used);
+  }
+  catch (const std::exception&)
+  {
+    used = 0;
+  }
+  if (used != text.size() || text.empty() || !std::isfinite(value))
+    throw UsageError(option + ": expected a finite number, got '" + text + "'");
+  return value;
+}
+
+long long parsePositiveInteger(const std::string& option, const std::string& text)
+{
+  std::size_t used = 0;
+  long long value = 0;
+  try
+  {
+    value = std::stoll(text, &used);
+  }
+  catch (const std::exception&)
+  {
+    used = 0;
+  }
+  if (used != text.size() || text.empty() || value < 1)
+    throw UsageError(option + ": expected an integer >= 1, got '" + text + "'");
+  return value;
+}
+
+Options parseOptions(const std::vector<std::string>& args)
+{
+  Options options;
+  std::map<std::string, std::string> values;
+  for (std::size_t k = 0; k < args.size(); k += 2)
+  {
+    const std::string& option = args[k];
+    static const char* const kKnown[] = { "--scene", "--duration", "--integrator", "--dt",
+                                          "--substeps", "--iterations", "--every", "--csv" };
+    if (std::find(std::begin(kKnown), std::end(kKnown), option) == std::end(kKnown))
+      throw UsageError("unknown option '" + option + "'; " + kUsage);
+    if (k + 1 >= args.size())
+      throw UsageError(option + ": missing value");
+    if (!values.emplace(option, args[k + 1]).second)
+      throw UsageError(option + ": given twice");
+  }
+  if (!values.count("--scene"))
+    throw UsageError(std::string("--scene is required; ") + kUsage);
+  options.scene = values["--scene"];
+  if (values.count("--duration"))
+  {
+    options.duration = parseNumber("--duration", values["--duration"]);
+    if (options.duration < 0.0)
+      throw UsageError("--duration: must be >= 0, got '" + values["--duration"] + "'");
+  }
+  if (values.count("--integrator"))
+    options.integrator = values["--integrator"];
+  if (values.count("--dt"))
+  {
+    options.dt = parseNumber("--dt", values["--dt"]);
+    if (!(*options.dt > 0.0))
+      throw UsageError("--dt: must be > 0, got '" + values["--dt"] + "'");
+  }
+  const long long int_max = std::numeric_limits<int>::max();
+  if (values.count("--substeps"))
+    options.substeps = static_cast<int>(std::min(int_max, parsePositiveInteger("--substeps", values["--substeps"])));
+  if (values.count("--iterations"))
+    options.iterations =
+        static_cast<int>(std::min(int_max, parsePositiveInteger("--iterations", values["--iterations"])));
+  if (values.count("--every"))
+    options.every = parsePositiveInteger("--every", values["--every"]);
+  if (values.count("--csv"))
+    options.csv = values["--csv"];
+  return options;
+}
+
+/// Command-line values replace the scene file's.
+void applyOverrides(const Options& options, SceneDef& scene)
+{
+  if (options.integrator && !integratorFromName(*options.integrator, scene.physics.integrator))
+  {
+    std::string valid;
+    for (const std::string& name : integratorNames())
+      valid += (valid.empty() ? "" : ", ") + name;
+    throw UsageError("--integrator: unknown integrator '" + *options.integrator + "' (valid: " + valid + ")");
+  }
+  if (options.dt)
+    scene.physics.step.dt = *options.dt;
+  if (options.substeps)
+    scene.physics.step.substeps = *options.substeps;
+  if (options.iterations)
+    scene.physics.step.iterations = *options.iterations;
+}
+
+void writeRows(std::ostream& csv, const World& world)
+{
+  const double t = world.time();
+  for (const BodyRange& body : world.model().bodies)
+  {
+    for (int k = 0; k < body.count; ++k)
+    {
+      const auto x = world.state().position.col(body.first + k);
+      csv << t << ',' << body.name << ',' << k << ',' << x.x() << ',' << x.y() << ',' << x.z() << '\n';
+    }
+  }
+}
+
+void simulate(const Options& options, std::ostream& out)
+{
+  SceneDef scene = loadSceneFile(options.scene);
+  applyOverrides(options, scene);
+  World world = buildWorld(scene);
+  const long long steps = std::llround(options.duration / scene.physics.step.dt);
+
+  std::ofstream file;
+  if (options.csv)
+  {
+    file.open(*options.csv);
+    if (!file)
+      throw UsageError("--csv: cannot write '" + *options.csv + "'");
+  }
+  std::ostream& csv = options.csv ? file : out;
+  csv << std::setprecision(17) << "t,body,node,x,y,z\n";
+  writeRows(csv, world);
+  for (long long n = 1; n <= steps; ++n)
+  {
+    world.step();
+    if (n == steps || (options.every && n % *options.every == 0))
+      writeRows(csv, world);
+  }
+  csv.flush();
+  if (!csv)
+    throw UsageError("failed writing the CSV output");
+}
+}  // namespace
+
+int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err)
+{
+  try
+  {
+    simulate(parseOptions(args), out);
+    return 0;
+  }
+  catch (const std::exception& e)
+  {
+    err << "simulate: " << e.what() << '\n';
+    return 2;
+  }
+}
+
+}  // namespace soft_body_sim

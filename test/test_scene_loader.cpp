@@ -1,0 +1,925 @@
+// Scene loader: a valid scene becomes exactly the expected structs; every invalid one is rejected with
+// a one-line message "<source>:<line>: <key path>: <reason>" that points at the offending value.
+#include "soft_body_sim/scene/scene_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace soft_body_sim
+{
+namespace
+{
+const char* const kSource = "bad.yaml";
+
+std::string sceneDir() { return std::string(SOURCE_DIR) + "/config/scenes"; }
+
+/// Parses `yaml` expecting a SceneError whose message is one line starting with "<location>: " and
+/// containing every word of `reason_words`.
+void expectSceneError(const std::string& yaml, const std::string& location,
+                      const std::vector<std::string>& reason_words)
+{
+  try
+  {
+    parseScene(yaml, kSource);
+    ADD_FAILURE() << "accepted:\n" << yaml;
+  }
+  catch (const SceneError& e)
+  {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
+    EXPECT_EQ(message.rfind(location + ": ", 0), 0u) << "message: " << message << "\nexpected start: " << location;
+    for (const std::string& word : reason_words)
+      EXPECT_NE(message.find(word), std::string::npos) << "message: " << message << "\nmissing: " << word;
+  }
+}
+
+void expectVec3(const Vec3& actual, double x, double y, double z)
+{
+  EXPECT_EQ(actual, Vec3(x, y, z)) << "actual: " << actual.transpose();
+}
+
+// --- valid scenes ------------------------------------------------------------------------------
+
+const char* const kContractExample = R"(frame_id: world
+physics:
+  integrator: semi_implicit_euler
+  dt: 0.001
+  substeps: 1
+  iterations: 1
+  gravity: [0.0, 0.0, -9.81]
+  drag: 0.0
+bodies:
+  - name: pair
+    type: custom
+    nodes:
+      - {position: [2, 4, 0], mass: 1}
+      - {position: [1, -3, 0], mass: 1, velocity: [0, 0, 0], pinned: false}
+    springs:
+      - {nodes: [0, 1], stiffness: 2, rest_length: 4, damping: 0}
+    constraints:
+      - {nodes: [0, 1], compliance: 0.0}
+)";
+
+TEST(SceneLoader, ContractExampleParsesToTheExpectedStructs)
+{
+  const SceneDef scene = parseScene(kContractExample, "example.yaml");
+  EXPECT_EQ(scene.frame_id, "world");
+  EXPECT_EQ(scene.physics.integrator, IntegratorType::SemiImplicitEuler);
+  EXPECT_EQ(scene.physics.step.dt, 0.001);
+  EXPECT_EQ(scene.physics.step.substeps, 1);
+  EXPECT_EQ(scene.physics.step.iterations, 1);
+  expectVec3(scene.physics.gravity, 0.0, 0.0, -9.81);
+  EXPECT_EQ(scene.physics.drag, 0.0);
+
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  const BodyDef& body = scene.bodies[0];
+  EXPECT_EQ(body.name, "pair");
+  EXPECT_EQ(body.type, "custom");
+  ASSERT_EQ(body.nodes.size(), 2u);
+  expectVec3(body.nodes[0].position, 2.0, 4.0, 0.0);
+  EXPECT_EQ(body.nodes[0].mass, 1.0);
+  expectVec3(body.nodes[0].velocity, 0.0, 0.0, 0.0);
+  EXPECT_FALSE(body.nodes[0].pinned);
+  expectVec3(body.nodes[1].position, 1.0, -3.0, 0.0);
+  EXPECT_EQ(body.nodes[1].mass, 1.0);
+  expectVec3(body.nodes[1].velocity, 0.0, 0.0, 0.0);
+  EXPECT_FALSE(body.nodes[1].pinned);
+
+  ASSERT_EQ(body.springs.size(), 1u);
+  EXPECT_EQ(body.springs[0].a, 0);
+  EXPECT_EQ(body.springs[0].b, 1);
+  EXPECT_EQ(body.springs[0].stiffness, 2.0);
+  EXPECT_EQ(body.springs[0].damping, 0.0);
+  ASSERT_TRUE(body.springs[0].rest_length.has_value());
+  EXPECT_EQ(*body.springs[0].rest_length, 4.0);
+
+  ASSERT_EQ(body.constraints.size(), 1u);
+  EXPECT_EQ(body.constraints[0].a, 0);
+  EXPECT_EQ(body.constraints[0].b, 1);
+  EXPECT_EQ(body.constraints[0].compliance, 0.0);
+  EXPECT_FALSE(body.constraints[0].rest_length.has_value());
+}
+
+TEST(SceneLoader, DefaultsFillEveryOptionalKey)
+{
+  const SceneDef scene = parseScene(R"(bodies:
+  - name: lone
+    type: custom
+    nodes:
+      - {position: [1, 2, 3], mass: 0.5}
+      - {position: [0, 0, 0], mass: 2}
+    springs:
+      - {nodes: [1, 0], stiffness: 10}
+)",
+                                    "defaults.yaml");
+  const PhysicsDef defaults;
+  EXPECT_EQ(scene.frame_id, "world");
+  EXPECT_EQ(scene.physics.integrator, IntegratorType::SemiImplicitEuler);
+  EXPECT_EQ(scene.physics.step.dt, 0.001);
+  EXPECT_EQ(scene.physics.step.substeps, 1);
+  EXPECT_EQ(scene.physics.step.iterations, 1);
+  expectVec3(scene.physics.gravity, 0.0, 0.0, -9.81);
+  EXPECT_EQ(scene.physics.drag, 0.0);
+  EXPECT_EQ(scene.physics.step.dt, defaults.step.dt);
+
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  const BodyDef& body = scene.bodies[0];
+  ASSERT_EQ(body.nodes.size(), 2u);
+  expectVec3(body.nodes[0].position, 1.0, 2.0, 3.0);
+  EXPECT_EQ(body.nodes[0].mass, 0.5);
+  expectVec3(body.nodes[0].velocity, 0.0, 0.0, 0.0);
+  EXPECT_FALSE(body.nodes[0].pinned);
+  ASSERT_EQ(body.springs.size(), 1u);
+  EXPECT_EQ(body.springs[0].a, 1);
+  EXPECT_EQ(body.springs[0].b, 0);
+  EXPECT_EQ(body.springs[0].damping, 0.0);
+  EXPECT_FALSE(body.springs[0].rest_length.has_value());
+  EXPECT_TRUE(body.constraints.empty());
+}
+
+TEST(SceneLoader, EveryPhysicsKeyAndNodeKeyIsRead)
+{
+  const SceneDef scene = parseScene(R"(frame_id: map
+physics:
+  integrator: xpbd
+  dt: 0.02
+  substeps: 4
+  iterations: 12
+  gravity: [0, -1.62, 0]
+  drag: 0.25
+bodies:
+  - name: a
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1, velocity: [1, -2, 3.5], pinned: true}
+      - {position: [0, 1, 0], mass: 1, pinned: True}
+      - {position: [0, 2, 0], mass: 1, pinned: FALSE}
+    springs:
+      - {nodes: [0, 2], stiffness: 5, damping: 0.5}
+    constraints:
+      - {nodes: [2, 1], compliance: 0.001, rest_length: 0}
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 1], mass: 3}
+)",
+                                    "full.yaml");
+  EXPECT_EQ(scene.frame_id, "map");
+  EXPECT_EQ(scene.physics.integrator, IntegratorType::Xpbd);
+  EXPECT_EQ(scene.physics.step.dt, 0.02);
+  EXPECT_EQ(scene.physics.step.substeps, 4);
+  EXPECT_EQ(scene.physics.step.iterations, 12);
+  expectVec3(scene.physics.gravity, 0.0, -1.62, 0.0);
+  EXPECT_EQ(scene.physics.drag, 0.25);
+  ASSERT_EQ(scene.bodies.size(), 2u);
+  const BodyDef& a = scene.bodies[0];
+  expectVec3(a.nodes[0].velocity, 1.0, -2.0, 3.5);
+  EXPECT_TRUE(a.nodes[0].pinned);
+  EXPECT_TRUE(a.nodes[1].pinned);
+  EXPECT_FALSE(a.nodes[2].pinned);
+  EXPECT_EQ(a.springs[0].damping, 0.5);
+  EXPECT_EQ(a.constraints[0].a, 2);
+  EXPECT_EQ(a.constraints[0].b, 1);
+  EXPECT_EQ(a.constraints[0].compliance, 0.001);
+  ASSERT_TRUE(a.constraints[0].rest_length.has_value());
+  EXPECT_EQ(*a.constraints[0].rest_length, 0.0);
+  EXPECT_EQ(scene.bodies[1].name, "b");
+  EXPECT_EQ(scene.bodies[1].nodes[0].mass, 3.0);
+}
+
+TEST(SceneLoader, EveryIntegratorNameIsAccepted)
+{
+  for (const std::string& name : integratorNames())
+  {
+    const SceneDef scene = parseScene("physics: {integrator: " + name +
+                                          "}\nbodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]\n",
+                                      "integrator.yaml");
+    EXPECT_EQ(integratorName(scene.physics.integrator), name);
+  }
+}
+
+TEST(SceneLoader, TrailingEmptyDocumentIsAccepted)
+{
+  const SceneDef scene =
+      parseScene("bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]\n---\n# empty\n",
+                 "trailing.yaml");
+  EXPECT_EQ(scene.bodies.size(), 1u);
+}
+
+TEST(SceneLoader, EmptySpringAndConstraintListsAreAccepted)
+{
+  const SceneDef scene = parseScene(R"(bodies:
+  - {name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}], springs: [], constraints: []}
+)",
+                                    "empty_lists.yaml");
+  EXPECT_TRUE(scene.bodies[0].springs.empty());
+  EXPECT_TRUE(scene.bodies[0].constraints.empty());
+}
+
+// --- invalid scenes ----------------------------------------------------------------------------
+
+struct BadScene
+{
+  const char* name;      ///< the test's name: says what is wrong
+  const char* yaml;      ///< starts right after R"( so that its first line is line 1
+  const char* location;  ///< the message's start, "bad.yaml:<line>: <key path>"
+  std::vector<std::string> reason_words;
+};
+
+void PrintTo(const BadScene& bad, std::ostream* out) { *out << bad.name; }
+
+// Most cases edit one line of this minimal valid scene (nodes on lines 5 and 6, springs from line 8).
+//   1 bodies:
+//   2   - name: b
+//   3     type: custom
+//   4     nodes:
+//   5       - {position: [0, 0, 0], mass: 1}
+//   6       - {position: [1, 0, 0], mass: 1}
+//   7     springs:
+//   8       - {nodes: [0, 1], stiffness: 1}
+const BadScene kBadScenes[] = {
+  // --- unknown keys
+  { "UnknownTopLevelKey", R"(frame: world
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, physics, bodies" } },
+  { "UnknownPhysicsKey", R"(physics:
+  dt: 0.01
+  timestep: 0.01
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:3: physics.timestep",
+    { "unknown key 'timestep'", "integrator, dt, substeps, iterations, gravity, drag" } },
+  { "UnknownBodyKey", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+    spring: []
+)",
+    "bad.yaml:6: bodies[0].spring", { "unknown key 'spring'", "name, type, nodes, springs, constraints" } },
+  { "UnknownNodeKey", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mas: 1}
+)",
+    "bad.yaml:6: bodies[0].nodes[1].mas", { "unknown key 'mas'", "position, mass, velocity, pinned" } },
+  { "UnknownSpringKey", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 1, rest: 4}
+)",
+    "bad.yaml:8: bodies[0].springs[0].rest", { "unknown key 'rest'", "nodes, stiffness, damping, rest_length" } },
+  { "UnknownConstraintKey", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    constraints:
+      - {nodes: [0, 1], stiffness: 1}
+)",
+    "bad.yaml:8: bodies[0].constraints[0].stiffness",
+    { "unknown key 'stiffness'", "nodes, compliance, rest_length" } },
+  { "DuplicateKey", R"(physics:
+  dt: 0.01
+  dt: 0.02
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:3: physics.dt", { "duplicate key" } },
+  { "NonStringKey", R"(physics:
+  [dt]: 0.01
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics", { "keys must be strings", "a list" } },
+
+  // --- wrong types
+  { "DtIsAWord", R"(physics:
+  dt: fast
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.dt", { "expected a number", "'fast'" } },
+  { "DtIsAQuotedNumber", R"(physics:
+  dt: "0.01"
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.dt", { "expected a number", "quoted string" } },
+  { "DtIsEmpty", R"(physics:
+  dt:
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.dt", { "expected a number", "empty value" } },
+  { "PhysicsIsAList", R"(physics: [0.01]
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:1: physics", { "expected a mapping", "a list" } },
+  { "BodiesIsAScalar", R"(bodies: pair
+)",
+    "bad.yaml:1: bodies", { "expected a list", "'pair'" } },
+  { "BodyIsAScalar", R"(bodies:
+  - pair
+)",
+    "bad.yaml:2: bodies[0]", { "expected a mapping", "'pair'" } },
+  { "NodesIsAMapping", R"(bodies:
+  - name: b
+    type: custom
+    nodes: {position: [0, 0, 0], mass: 1}
+)",
+    "bad.yaml:4: bodies[0].nodes", { "expected a list", "a mapping" } },
+  { "SpringsIsAScalar", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+    springs: none
+)",
+    "bad.yaml:6: bodies[0].springs", { "expected a list", "'none'" } },
+  { "PositionHasTwoNumbers", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0], mass: 1}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].position", { "3 numbers", "2 item" } },
+  { "PositionIsAScalar", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: 1, mass: 1}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].position", { "expected a list of 3 numbers", "'1'" } },
+  { "VelocityComponentIsAWord", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1, velocity: [0, 0, up]}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].velocity[2]", { "expected a number", "'up'" } },
+  { "GravityHasFourNumbers", R"(physics:
+  gravity: [0, 0, -9.81, 0]
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.gravity", { "3 numbers", "4 item" } },
+  { "MassIsAList", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: [1]}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].mass", { "expected a number", "a list" } },
+  { "PinnedIsMaybe", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1, pinned: maybe}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].pinned", { "true or false", "'maybe'" } },
+  { "PinnedIsYes", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1, pinned: yes}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].pinned", { "true or false", "'yes'" } },
+  { "PinnedIsOne", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1, pinned: 1}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].pinned", { "true or false", "'1'" } },
+  { "SpringIndexIsFractional", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1.5], stiffness: 1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].nodes[1]", { "must be an integer", "'1.5'" } },
+  { "SpringIndexIsAWord", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [first, 1], stiffness: 1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].nodes[0]", { "expected an integer", "'first'" } },
+  { "SpringHasThreeIndices", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1, 0], stiffness: 1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].nodes", { "2 node indices", "3 item" } },
+  { "SubstepsIsFractional", R"(physics:
+  substeps: 2.5
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.substeps", { "must be an integer", "'2.5'" } },
+  { "IterationsIsAWord", R"(physics:
+  iterations: many
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.iterations", { "expected an integer", "'many'" } },
+  { "NameIsAList", R"(bodies:
+  - name: [b]
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+)",
+    "bad.yaml:2: bodies[0].name", { "expected a string", "a list" } },
+
+  // --- missing required keys
+  { "MissingBodies", R"(frame_id: world
+physics: {dt: 0.01}
+)",
+    "bad.yaml:1: bodies", { "missing required key" } },
+  { "MissingName", R"(bodies:
+  - type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+)",
+    "bad.yaml:2: bodies[0].name", { "missing required key" } },
+  { "MissingType", R"(bodies:
+  - name: b
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+)",
+    "bad.yaml:2: bodies[0].type", { "missing required key" } },
+  { "MissingNodes", R"(bodies:
+  - name: b
+    type: custom
+)",
+    "bad.yaml:2: bodies[0].nodes", { "missing required key" } },
+  { "MissingPosition", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {mass: 1}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].position", { "missing required key" } },
+  { "MissingMass", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0]}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].mass", { "missing required key" } },
+  { "MissingSpringNodes", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {stiffness: 1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].nodes", { "missing required key" } },
+  { "MissingStiffness", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], damping: 1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].stiffness", { "missing required key" } },
+  { "MissingConstraintNodes", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    constraints:
+      - {compliance: 0}
+)",
+    "bad.yaml:8: bodies[0].constraints[0].nodes", { "missing required key" } },
+
+  // --- values out of range
+  { "ZeroMass", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 0}
+)",
+    "bad.yaml:6: bodies[0].nodes[1].mass", { "must be > 0", "got 0" } },
+  { "NegativeMass", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: -1.5}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].mass", { "must be > 0", "got -1.5" } },
+  { "ZeroDt", R"(physics:
+  dt: 0
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.dt", { "must be > 0" } },
+  { "NegativeDt", R"(physics:
+  dt: -0.01
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.dt", { "must be > 0", "-0.01" } },
+  { "ZeroSubsteps", R"(physics:
+  substeps: 0
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.substeps", { "[1, ", "got 0" } },
+  { "ZeroIterations", R"(physics:
+  iterations: 0
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.iterations", { "[1, ", "got 0" } },
+  { "SubstepsBeyondInt", R"(physics:
+  substeps: 99999999999
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.substeps", { "[1, 2147483647]" } },
+  { "NegativeDrag", R"(physics:
+  drag: -0.1
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.drag", { "must be >= 0", "-0.1" } },
+  { "ZeroStiffness", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 0}
+)",
+    "bad.yaml:8: bodies[0].springs[0].stiffness", { "must be > 0" } },
+  { "NegativeStiffness", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: -3}
+)",
+    "bad.yaml:8: bodies[0].springs[0].stiffness", { "must be > 0", "-3" } },
+  { "NegativeDamping", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 1, damping: -0.5}
+)",
+    "bad.yaml:8: bodies[0].springs[0].damping", { "must be >= 0", "-0.5" } },
+  { "NegativeSpringRestLength", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 1, rest_length: -1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].rest_length", { "must be >= 0", "-1" } },
+  { "NegativeCompliance", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    constraints:
+      - {nodes: [0, 1], compliance: -0.001}
+)",
+    "bad.yaml:8: bodies[0].constraints[0].compliance", { "must be >= 0", "-0.001" } },
+  { "NegativeConstraintRestLength", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    constraints:
+      - {nodes: [0, 1], rest_length: -0.2}
+)",
+    "bad.yaml:8: bodies[0].constraints[0].rest_length", { "must be >= 0", "-0.2" } },
+
+  // --- non-finite numbers
+  { "NanMass", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: .nan}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].mass", { "finite", ".nan" } },
+  { "InfiniteDt", R"(physics:
+  dt: .inf
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.dt", { "finite", ".inf" } },
+  { "NegativeInfiniteGravity", R"(physics:
+  gravity: [0, 0, -.inf]
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.gravity[2]", { "finite", "-.inf" } },
+  { "NanPosition", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [.NaN, 0, 0], mass: 1}
+)",
+    "bad.yaml:5: bodies[0].nodes[0].position[0]", { "finite" } },
+  { "InfiniteRestLength", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 1, rest_length: .inf}
+)",
+    "bad.yaml:8: bodies[0].springs[0].rest_length", { "finite" } },
+
+  // --- node indices
+  { "SpringIndexOutOfRange", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 1}
+      - {nodes: [1, 2], stiffness: 1}
+)",
+    "bad.yaml:9: bodies[0].springs[1].nodes[1]", { "node index 2 out of range", "2 nodes" } },
+  { "SpringIndexNegative", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [-1, 1], stiffness: 1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].nodes[0]", { "node index -1 out of range", "2 nodes" } },
+  { "ConstraintIndexOutOfRange", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    constraints:
+      - {nodes: [5, 0]}
+)",
+    "bad.yaml:8: bodies[0].constraints[0].nodes[0]", { "node index 5 out of range", "2 nodes" } },
+  { "SpringFromANodeToItself", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    springs:
+      - {nodes: [1, 1], stiffness: 1}
+)",
+    "bad.yaml:8: bodies[0].springs[0].nodes", { "connects node 1 to itself" } },
+  { "ConstraintFromANodeToItself", R"(bodies:
+  - name: b
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+      - {position: [1, 0, 0], mass: 1}
+    constraints:
+      - {nodes: [0, 0]}
+)",
+    "bad.yaml:8: bodies[0].constraints[0].nodes", { "connects node 0 to itself" } },
+
+  // --- names
+  { "UnknownIntegrator", R"(physics:
+  integrator: leapfrog
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.integrator",
+    { "unknown integrator 'leapfrog'",
+      "explicit_euler, semi_implicit_euler, verlet, velocity_verlet, rk4, implicit_euler, xpbd" } },
+  { "UnknownBodyType", R"(bodies:
+  - name: b
+    type: rope
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+)",
+    "bad.yaml:3: bodies[0].type", { "unknown body type 'rope'", "custom" } },
+  { "DuplicateBodyName", R"(bodies:
+  - name: twin
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+  - name: twin
+    type: custom
+    nodes:
+      - {position: [1, 0, 0], mass: 1}
+)",
+    "bad.yaml:6: bodies[1].name", { "duplicate body name 'twin'", "bodies[0]" } },
+  { "EmptyBodyName", R"(bodies:
+  - name: ""
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1}
+)",
+    "bad.yaml:2: bodies[0].name", { "must not be empty" } },
+  { "EmptyFrameId", R"(frame_id: ''
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:1: frame_id", { "must not be empty" } },
+
+  // --- empty lists
+  { "EmptyBodies", R"(frame_id: world
+bodies: []
+)",
+    "bad.yaml:2: bodies", { "must not be empty" } },
+  { "EmptyNodes", R"(bodies:
+  - name: b
+    type: custom
+    nodes: []
+)",
+    "bad.yaml:4: bodies[0].nodes", { "must not be empty" } },
+
+  // --- the document itself
+  { "MalformedYaml", R"(bodies:
+  - name: b
+    nodes: [{position: [0, 0, 0], mass: 1}
+  - name: c
+)",
+    "bad.yaml:4:3", { "invalid YAML", "illegal block entry" } },
+  { "TopLevelIsAList", R"(- name: b
+  type: custom
+)",
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, physics, bodies", "a list" } },
+  { "TopLevelIsAScalar", R"(hello
+)",
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "'hello'" } },
+  { "EmptyDocument", R"(# nothing but a comment
+)",
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "empty document" } },
+  { "TwoDocuments", R"(bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+---
+bodies: [{name: c, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:3: (top level)", { "second YAML document" } },
+  { "MultiLineValueStaysOneLine", R"(physics:
+  integrator: "semi\nimplicit"
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+)",
+    "bad.yaml:2: physics.integrator", { "unknown integrator 'semi\\nimplicit'" } },
+};
+
+class BadSceneTest : public ::testing::TestWithParam<BadScene>
+{
+};
+
+TEST_P(BadSceneTest, IsRejectedWithSourceLineKeyPathAndReason)
+{
+  const BadScene& bad = GetParam();
+  expectSceneError(bad.yaml, bad.location, bad.reason_words);
+}
+
+INSTANTIATE_TEST_SUITE_P(SceneLoader, BadSceneTest, ::testing::ValuesIn(kBadScenes),
+                         [](const ::testing::TestParamInfo<BadScene>& info) { return std::string(info.param.name); });
+
+// --- files -------------------------------------------------------------------------------------
+
+TEST(SceneLoader, EveryExampleSceneLoads)
+{
+  int count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(sceneDir()))
+  {
+    if (entry.path().extension() != ".yaml")
+      continue;
+    SCOPED_TRACE(entry.path().string());
+    EXPECT_NO_THROW(loadSceneFile(entry.path().string()));
+    ++count;
+  }
+  EXPECT_GE(count, 2);
+}
+
+TEST(SceneLoader, TumExercise1HasTheExerciseValues)
+{
+  const SceneDef scene = loadSceneFile(sceneDir() + "/tum_exercise_1.yaml");
+  EXPECT_EQ(scene.physics.integrator, IntegratorType::ExplicitEuler);
+  EXPECT_EQ(scene.physics.step.dt, 0.5);
+  expectVec3(scene.physics.gravity, 0.0, 0.0, 0.0);
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  const BodyDef& body = scene.bodies[0];
+  ASSERT_EQ(body.nodes.size(), 2u);
+  expectVec3(body.nodes[0].position, 2.0, 4.0, 0.0);
+  expectVec3(body.nodes[1].position, 1.0, -3.0, 0.0);
+  EXPECT_EQ(body.nodes[0].mass, 1.0);
+  EXPECT_EQ(body.nodes[1].mass, 1.0);
+  ASSERT_EQ(body.springs.size(), 1u);
+  EXPECT_EQ(body.springs[0].stiffness, 2.0);
+  ASSERT_TRUE(body.springs[0].rest_length.has_value());
+  EXPECT_EQ(*body.springs[0].rest_length, 4.0);
+}
+
+TEST(SceneLoader, HangingChainIsOneMetreOfChainOverAnEightyCentimetreSpan)
+{
+  const SceneDef scene = loadSceneFile(sceneDir() + "/hanging_chain.yaml");
+  EXPECT_EQ(scene.physics.integrator, IntegratorType::ImplicitEuler);
+  EXPECT_EQ(scene.physics.step.dt, 0.005);
+  EXPECT_EQ(scene.physics.drag, 0.5);
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  const BodyDef& chain = scene.bodies[0];
+  ASSERT_EQ(chain.nodes.size(), 21u);
+  ASSERT_EQ(chain.springs.size(), 20u);
+
+  double total_mass = 0.0;
+  for (const NodeDef& node : chain.nodes)
+    total_mass += node.mass;
+  EXPECT_NEAR(total_mass, 0.1, 1e-12);
+  for (std::size_t i = 0; i < chain.nodes.size(); ++i)
+    EXPECT_EQ(chain.nodes[i].pinned, i == 0 || i + 1 == chain.nodes.size()) << "node " << i;
+  EXPECT_NEAR((chain.nodes.front().position - chain.nodes.back().position).norm(), 0.8, 1e-12);
+
+  double length = 0.0;
+  for (std::size_t k = 0; k < chain.springs.size(); ++k)
+  {
+    const SpringDef& spring = chain.springs[k];
+    EXPECT_EQ(spring.a, static_cast<int>(k));
+    EXPECT_EQ(spring.b, static_cast<int>(k) + 1);
+    EXPECT_EQ(spring.stiffness, 1000.0);
+    EXPECT_GT(spring.damping, 0.0);
+    ASSERT_TRUE(spring.rest_length.has_value());
+    length += *spring.rest_length;
+    // Springs start at rest: the initial distance is the rest length.
+    const double distance = (chain.nodes[k].position - chain.nodes[k + 1].position).norm();
+    EXPECT_NEAR(distance, *spring.rest_length, 1e-9) << "spring " << k;
+  }
+  EXPECT_NEAR(length, 1.0, 1e-12);
+}
+
+TEST(SceneLoader, MissingFileCannotBeOpened)
+{
+  const std::string path = sceneDir() + "/no_such_scene.yaml";
+  try
+  {
+    loadSceneFile(path);
+    ADD_FAILURE() << "loaded a missing file";
+  }
+  catch (const SceneError& e)
+  {
+    EXPECT_EQ(std::string(e.what()), path + ": cannot open scene file");
+  }
+}
+
+TEST(SceneLoader, DirectoryCannotBeOpened)
+{
+  try
+  {
+    loadSceneFile(sceneDir());
+    ADD_FAILURE() << "loaded a directory";
+  }
+  catch (const SceneError& e)
+  {
+    EXPECT_EQ(std::string(e.what()), sceneDir() + ": cannot open scene file");
+  }
+}
+
+TEST(SceneLoader, ErrorsInAFileNameThePath)
+{
+  const std::string path = (std::filesystem::temp_directory_path() / "soft_body_sim_bad_scene.yaml").string();
+  {
+    std::ofstream file(path);
+    file << "physics:\n  dt: -1\nbodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]\n";
+  }
+  try
+  {
+    loadSceneFile(path);
+    ADD_FAILURE() << "loaded a scene with dt -1";
+  }
+  catch (const SceneError& e)
+  {
+    EXPECT_EQ(std::string(e.what()), path + ":2: physics.dt: must be > 0, got -1");
+  }
+  std::remove(path.c_str());
+}
+
+}  // namespace
+}  // namespace soft_body_sim

@@ -1,0 +1,164 @@
+// The headless simulator's command-line contract (other tools drive it): CSV layout, row times,
+// precision, overrides, and one-line errors with a non-zero status.
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "soft_body_sim/tools/simulate.h"
+
+namespace soft_body_sim
+{
+namespace
+{
+// The TUM tutorial's exercise 1 (explicit Euler, h = 0.5): after two steps P1 = (2, 4) + 0.25 f u.
+const char* const kTumScene = R"(
+frame_id: world
+physics: {integrator: explicit_euler, dt: 0.5, gravity: [0, 0, 0]}
+bodies:
+  - name: pair
+    type: custom
+    nodes:
+      - {position: [2, 4, 0], mass: 1}
+      - {position: [1, -3, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 2, rest_length: 4}
+)";
+
+std::string writeScene(const std::string& name, const std::string& text)
+{
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+struct Outcome
+{
+  int status;
+  std::string out;
+  std::string err;
+};
+
+Outcome runWith(const std::vector<std::string>& args)
+{
+  std::ostringstream out, err;
+  const int status = runSimulate(args, out, err);
+  return { status, out.str(), err.str() };
+}
+
+std::vector<std::vector<std::string>> rows(const std::string& csv)
+{
+  std::vector<std::vector<std::string>> table;
+  std::istringstream lines(csv);
+  for (std::string line; std::getline(lines, line);)
+  {
+    std::vector<std::string> cells;
+    std::istringstream fields(line);
+    for (std::string cell; std::getline(fields, cell, ',');)
+      cells.push_back(cell);
+    table.push_back(cells);
+  }
+  return table;
+}
+
+TEST(Simulate, WritesHeaderInitialAndFinalRowsAtFullPrecision)
+{
+  const std::string scene = writeScene("tum.yaml", kTumScene);
+  const Outcome r = runWith({ "--scene", scene, "--duration", "1" });
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  const auto table = rows(r.out);
+  ASSERT_EQ(table.size(), 5u);  // header, 2 nodes at t = 0, 2 nodes at t = 1
+  EXPECT_EQ(table[0], (std::vector<std::string>{ "t", "body", "node", "x", "y", "z" }));
+  EXPECT_EQ(table[1], (std::vector<std::string>{ "0", "pair", "0", "2", "4", "0" }));
+  EXPECT_EQ(table[3][0], "1");
+  EXPECT_EQ(table[3][1], "pair");
+  EXPECT_EQ(table[3][2], "0");
+  // 17 significant digits round-trip the double exactly.
+  const double f = -2.0 * (5.0 * std::sqrt(2.0) - 4.0);
+  const double expected_x = 2.0 + 0.25 * f / (5.0 * std::sqrt(2.0));
+  EXPECT_EQ(std::stod(table[3][3]), expected_x);
+  const std::string digits = table[3][3].substr(0, table[3][3].find('e'));
+  EXPECT_EQ(std::count_if(digits.begin(), digits.end(), ::isdigit), 17) << table[3][3];
+}
+
+TEST(Simulate, RowsEveryKStepsAndAlwaysAfterTheLast)
+{
+  const std::string scene = writeScene("every.yaml", kTumScene);
+  // round(2.6 / 0.5) = 5 steps; every 2 -> t = 0, 1, 2 and the last, 2.5.
+  const Outcome r = runWith({ "--scene", scene, "--duration", "2.6", "--every", "2" });
+  ASSERT_EQ(r.status, 0) << r.err;
+  std::vector<std::string> times;
+  for (const auto& row : rows(r.out))
+    if (row[0] != "t" && row[2] == "0")
+      times.push_back(row[0]);
+  EXPECT_EQ(times, (std::vector<std::string>{ "0", "1", "2", "2.5" }));
+}
+
+TEST(Simulate, CommandLineOverridesTheSceneAndCsvGoesToTheFile)
+{
+  const std::string scene = writeScene("override.yaml", kTumScene);
+  const std::string csv = ::testing::TempDir() + "override.csv";
+  const Outcome r = runWith({ "--scene", scene, "--duration", "1", "--dt", "0.25", "--integrator", "rk4", "--substeps", "2",
+                      "--iterations", "3", "--csv", csv });
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.out, "");
+  std::ifstream file(csv);
+  const std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  const auto table = rows(text);
+  ASSERT_EQ(table.size(), 5u);
+  EXPECT_EQ(table[3][0], "1");  // 4 steps of 0.25 s
+  // rk4 at h = 0.125 differs from the explicit Euler answer of the file's settings.
+  const double f = -2.0 * (5.0 * std::sqrt(2.0) - 4.0);
+  EXPECT_NE(std::stod(table[3][3]), 2.0 + 0.25 * f / (5.0 * std::sqrt(2.0)));
+}
+
+struct BadInput
+{
+  const char* name;
+  std::vector<std::string> args;  ///< "SCENE" stands for a valid scene file
+  const char* reason;             ///< a substring of the one-line message
+};
+
+class SimulateRejects : public ::testing::TestWithParam<BadInput>
+{
+};
+
+TEST_P(SimulateRejects, WithOneLineAndNonZeroStatus)
+{
+  const std::string scene = writeScene("valid.yaml", kTumScene);
+  std::vector<std::string> args = GetParam().args;
+  for (std::string& a : args)
+    if (a == "SCENE")
+      a = scene;
+  const Outcome r = runWith(args);
+  EXPECT_NE(r.status, 0);
+  EXPECT_EQ(r.out, "");
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find(GetParam().reason), std::string::npos) << r.err;
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, SimulateRejects,
+    ::testing::Values(BadInput{ "NoScene", {}, "--scene is required" },
+                      BadInput{ "UnknownOption", { "--scene", "SCENE", "--speed", "2" }, "unknown option '--speed'" },
+                      BadInput{ "MissingValue", { "--scene", "SCENE", "--dt" }, "--dt: missing value" },
+                      BadInput{ "NegativeDt", { "--scene", "SCENE", "--dt", "-1" }, "--dt: must be > 0" },
+                      BadInput{ "ZeroDt", { "--scene", "SCENE", "--dt", "0" }, "--dt: must be > 0" },
+                      BadInput{ "TextDt", { "--scene", "SCENE", "--dt", "fast" }, "--dt: expected a finite number" },
+                      BadInput{ "NanDuration", { "--scene", "SCENE", "--duration", "nan" }, "--duration: expected a finite" },
+                      BadInput{ "NegativeDuration", { "--scene", "SCENE", "--duration", "-2" }, "--duration: must be >= 0" },
+                      BadInput{ "ZeroSubsteps", { "--scene", "SCENE", "--substeps", "0" }, "--substeps: expected an integer >= 1" },
+                      BadInput{ "FractionalIterations", { "--scene", "SCENE", "--iterations", "1.5" }, "--iterations: expected an integer" },
+                      BadInput{ "ZeroEvery", { "--scene", "SCENE", "--every", "0" }, "--every: expected an integer >= 1" },
+                      BadInput{ "UnknownIntegrator", { "--scene", "SCENE", "--integrator", "euler" }, "unknown integrator 'euler' (valid: explicit_euler," },
+                      BadInput{ "MissingSceneFile", { "--scene", "/nonexistent/scene.yaml" }, "/nonexistent/scene.yaml: cannot open" },
+                      BadInput{ "UnwritableCsv", { "--scene", "SCENE", "--csv", "/nonexistent/out.csv" }, "--csv: cannot write" },
+                      BadInput{ "GivenTwice", { "--scene", "SCENE", "--dt", "1", "--dt", "2" }, "--dt: given twice" }),
+    [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
+
+}  // namespace
+}  // namespace soft_body_sim
