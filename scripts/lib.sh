@@ -34,10 +34,11 @@ install_missing() {
 # Configures (once) and builds; the full output goes to build/build.log, shown when the build fails.
 build_package() {
   mkdir -p "$BUILD"
+  : >"$BUILD/build.log"
   if [ ! -f "$BUILD/Makefile" ]; then
     log "configuring into $BUILD"
     cmake -S "$ROOT" -B "$BUILD" -DPYTHON_EXECUTABLE=/usr/bin/python3 -DCMAKE_BUILD_TYPE=Release \
-      >"$BUILD/build.log" 2>&1 || { cat "$BUILD/build.log" >&2; return 1; }
+      >>"$BUILD/build.log" 2>&1 || { cat "$BUILD/build.log" >&2; return 1; }
   fi
   log "building"
   make -C "$BUILD" -j"$(nproc)" "$@" >>"$BUILD/build.log" 2>&1 || { tail -n 60 "$BUILD/build.log" >&2; return 1; }

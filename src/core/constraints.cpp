@@ -9,12 +9,11 @@ void solveDistance(const ConstraintRow& row, const Eigen::VectorXd& inverse_mass
 {
   const double w_a = inverse_mass[row.a];
   const double w_b = inverse_mass[row.b];
-  const Vec3 d = x.col(row.a) - x.col(row.b);
-  const double length = d.norm();
   const double denominator = (1.0 + row.gamma) * (w_a + w_b) + row.alpha_tilde;
-  if (length < kMinSpringLength || denominator < 1e-300 || w_a + w_b == 0.0)
+  Vec3 u;
+  double length;
+  if (w_a + w_b == 0.0 || denominator < 1e-300 || !springAxis(x, row.a, row.b, u, length))
     return;
-  const Vec3 u = d / length;
   const double c = length - row.rest_length;
   // gradC . (x - x_prev): the constraint's rate over this (sub)step times h, for the damping term.
   const double c_rate_h = u.dot((x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b)));

@@ -6,11 +6,10 @@ void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeAr
 {
   for (const Spring& s : model.springs)
   {
-    const Vec3 d = x.col(s.a) - x.col(s.b);
-    const double length = d.norm();
-    if (length < kMinSpringLength)
+    Vec3 u;
+    double length;
+    if (!springAxis(x, s.a, s.b, u, length))
       continue;
-    const Vec3 u = d / length;
     const double closing_speed = (v.col(s.a) - v.col(s.b)).dot(u);
     const Vec3 f = (-s.stiffness * (length - s.rest_length) - s.damping * closing_speed) * u;
     force.col(s.a) += f;

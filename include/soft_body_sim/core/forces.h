@@ -9,6 +9,18 @@ namespace soft_body_sim
 /// (coincident nodes must not produce NaN).
 constexpr double kMinSpringLength = 1e-12;
 
+/// Length [m] and unit direction u = d / |d| of d = x_a - x_b; false when the nodes (nearly) coincide
+/// and the direction is undefined, in which case the caller skips the pair.
+inline bool springAxis(const NodeArray& x, int a, int b, Vec3& u, double& length)
+{
+  const Vec3 d = x.col(a) - x.col(b);
+  length = d.norm();
+  if (length < kMinSpringLength)
+    return false;
+  u = d / length;
+  return true;
+}
+
 /// Adds every spring's Hooke + dashpot force [N] to `force` (see Spring).
 void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force);
 

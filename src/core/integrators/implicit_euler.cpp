@@ -80,11 +80,10 @@ private:
     }
     for (const Spring& s : model.springs)
     {
-      const Vec3 d = x.col(s.a) - x.col(s.b);
-      const double length = d.norm();
-      if (length < kMinSpringLength)
+      Vec3 u;
+      double length;
+      if (!springAxis(x, s.a, s.b, u, length))
         continue;
-      const Vec3 u = d / length;
       const Matrix3 uu = u * u.transpose();
       const double transverse = std::max(0.0, 1.0 - s.rest_length / length);
       // -df_a/dx_a of the spring (clamped, see above) and -df_a/dv_a of its dashpot.
