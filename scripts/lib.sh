@@ -11,7 +11,7 @@ export PATH="/usr/bin:/bin:/usr/sbin:/sbin:$PATH"
 PACKAGES=(
   build-essential cmake python3
   catkin python3-catkin-pkg ros-message-generation ros-message-runtime
-  libstd-msgs-dev libgeometry-msgs-dev
+  libstd-msgs-dev libgeometry-msgs-dev ros-std-msgs ros-geometry-msgs
   libeigen3-dev libyaml-cpp-dev
   googletest libgtest-dev
 )
