@@ -1,0 +1,228 @@
+#include "yaml_reader.h"
+
+#include <algorithm>
+#include <charconv>
+#include <climits>
+#include <cmath>
+#include <set>
+
+namespace soft_body_sim::scene_yaml
+{
+namespace
+{
+/// yaml-cpp gives quoted scalars the tag "!" and plain ones "?"; a quoted "1.5" is a string in YAML.
+bool isQuoted(const YAML::Node& node) { return node.Tag() == "!"; }
+}  // namespace
+
+std::string join(const Keys& words)
+{
+  std::string out;
+  for (const std::string& word : words)
+    out += (out.empty() ? "" : ", ") + word;
+  return out;
+}
+
+/// User text made safe for a one-line message: control characters escaped, long text shortened.
+std::string printable(const std::string& text)
+{
+  constexpr std::size_t kMaxLength = 60;
+  std::string out;
+  for (const char c : text.substr(0, kMaxLength))
+  {
+    if (c == '\n')
+      out += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
+      out += '?';
+    else
+      out += c;
+  }
+  return text.size() > kMaxLength ? out + "..." : out;
+}
+
+std::string quoted(const std::string& text) { return "'" + printable(text) + "'"; }
+
+/// What a wrong value was, for "expected X, got <describe>".
+std::string describe(const YAML::Node& node)
+{
+  switch (node.Type())
+  {
+    case YAML::NodeType::Null:
+      return "an empty value (null)";
+    case YAML::NodeType::Sequence:
+      return "a list";
+    case YAML::NodeType::Map:
+      return "a mapping";
+    case YAML::NodeType::Scalar:
+      return (isQuoted(node) ? "the quoted string " : "") + quoted(node.Scalar());
+    case YAML::NodeType::Undefined:
+      break;
+  }
+  return "nothing";
+}
+
+std::string childPath(const std::string& parent, const std::string& key)
+{
+  return parent.empty() ? key : parent + "." + key;
+}
+
+// --- structure// --- structure ---------------------------------------------------------------------------------
+
+void requireMapping(const Context& ctx, const Field& field)
+{
+  if (!field.node.IsMap())
+    ctx.fail(field, "expected a mapping, got " + describe(field.node));
+}
+
+/// A mapping whose keys are unique strings from `allowed`. Duplicates are rejected because yaml-cpp
+/// keeps both and lookups would silently use the first.
+void requireMap(const Context& ctx, const Field& field, const Keys& allowed)
+{
+  requireMapping(ctx, field);
+  std::set<std::string> seen;
+  for (const auto& entry : field.node)
+  {
+    const YAML::Node& key = entry.first;
+    if (!key.IsScalar())
+      ctx.fail(key.Mark(), field.path, "keys must be strings, got " + describe(key));
+    const std::string path = childPath(field.path, printable(key.Scalar()));
+    if (std::find(allowed.begin(), allowed.end(), key.Scalar()) == allowed.end())
+      ctx.fail(key.Mark(), path, "unknown key " + quoted(key.Scalar()) + "; allowed keys: " + join(allowed));
+    if (!seen.insert(key.Scalar()).second)
+      ctx.fail(key.Mark(), path, "duplicate key");
+  }
+}
+
+/// The value under `key` of a mapping checked by requireMap; nullopt if absent.
+std::optional<Field> optionalKey(const Field& map, const std::string& key)
+{
+  for (const auto& entry : map.node)
+    if (entry.first.Scalar() == key)
+      return Field{ entry.second, childPath(map.path, key), entry.first.Mark() };
+  return std::nullopt;
+}
+
+Field requiredKey(const Context& ctx, const Field& map, const std::string& key)
+{
+  if (std::optional<Field> field = optionalKey(map, key))
+    return *field;
+  ctx.fail(map.mark, childPath(map.path, key), "missing required key");
+}
+
+std::vector<Field> requireList(const Context& ctx, const Field& field, const std::string& expected)
+{
+  if (!field.node.IsSequence())
+    ctx.fail(field, "expected " + expected + ", got " + describe(field.node));
+  std::vector<Field> items;
+  for (const YAML::Node& item : field.node)
+    items.push_back({ item, field.path + "[" + std::to_string(items.size()) + "]", item.Mark() });
+  return items;
+}
+
+std::vector<Field> requireListOfSize(const Context& ctx, const Field& field, std::size_t size,
+                                     const std::string& what)
+{
+  const std::string expected = "a list of " + std::to_string(size) + " " + what;
+  std::vector<Field> items = requireList(ctx, field, expected);
+  if (items.size() != size)
+    ctx.fail(field, "expected " + expected + ", got " + std::to_string(items.size()) + " item(s)");
+  return items;
+}
+
+// --- scalars -----------------------------------------------------------------------------------
+
+double readNumber(const Context& ctx, const Field& field)
+{
+  double value = 0.0;
+  if (!field.node.IsScalar() || isQuoted(field.node) || !YAML::convert<double>::decode(field.node, value))
+    ctx.fail(field, "expected a number, got " + describe(field.node));
+  if (!std::isfinite(value))
+    ctx.fail(field, "must be a finite number, got " + quoted(field.node.Scalar()));
+  return value;
+}
+
+double readPositive(const Context& ctx, const Field& field)
+{
+  const double value = readNumber(ctx, field);
+  if (!(value > 0.0))
+    ctx.fail(field, "must be > 0, got " + field.node.Scalar());
+  return value;
+}
+
+double readNonNegative(const Context& ctx, const Field& field)
+{
+  const double value = readNumber(ctx, field);
+  if (value < 0.0)
+    ctx.fail(field, "must be >= 0, got " + field.node.Scalar());
+  return value;
+}
+
+/// A plain decimal integer as YAML 1.2 writes one ([-+]?[0-9]+). Parsed here rather than by
+/// yaml-cpp, which also takes 0x1F and reads 010 as octal 8.
+long long readInteger(const Context& ctx, const Field& field)
+{
+  if (!field.node.IsScalar() || isQuoted(field.node))
+    ctx.fail(field, "expected an integer, got " + describe(field.node));
+  const std::string& text = field.node.Scalar();
+  const char* first = text.data();
+  const char* last = text.data() + text.size();
+  if (first != last && *first == '+' && first + 1 != last && first[1] != '-')
+    ++first;  // from_chars takes a '-' but not a '+'
+  long long value = 0;
+  const auto [end, error] = std::from_chars(first, last, value);
+  if (error == std::errc::result_out_of_range)
+    ctx.fail(field, "integer out of range: " + quoted(text));
+  if (error != std::errc() || end != last)
+  {
+    double number = 0.0;
+    const bool is_number = YAML::convert<double>::decode(field.node, number);
+    ctx.fail(field, is_number ? "must be an integer, got " + quoted(text) : "expected an integer, got " + quoted(text));
+  }
+  return value;
+}
+
+int readAtLeastOne(const Context& ctx, const Field& field)
+{
+  const long long value = readInteger(ctx, field);
+  if (value < 1 || value > INT_MAX)
+    ctx.fail(field, "must be an integer in [1, " + std::to_string(INT_MAX) + "], got " + field.node.Scalar());
+  return static_cast<int>(value);
+}
+
+/// YAML 1.2 booleans only: yaml-cpp would also take yes/no/on/off/y/n, which YAML 1.2 reads as strings.
+bool readBool(const Context& ctx, const Field& field)
+{
+  static const Keys kTrue = { "true", "True", "TRUE" };
+  static const Keys kFalse = { "false", "False", "FALSE" };
+  const std::string text = field.node.IsScalar() && !isQuoted(field.node) ? field.node.Scalar() : "";
+  if (std::find(kTrue.begin(), kTrue.end(), text) != kTrue.end())
+    return true;
+  if (std::find(kFalse.begin(), kFalse.end(), text) != kFalse.end())
+    return false;
+  ctx.fail(field, "expected true or false, got " + describe(field.node));
+}
+
+std::string readNonEmptyString(const Context& ctx, const Field& field)
+{
+  if (!field.node.IsScalar())
+    ctx.fail(field, "expected a string, got " + describe(field.node));
+  if (field.node.Scalar().empty())
+    ctx.fail(field, "must not be empty");
+  return field.node.Scalar();
+}
+
+Vec3 readVec3(const Context& ctx, const Field& field)
+{
+  const std::vector<Field> items = requireListOfSize(ctx, field, 3, "numbers");
+  return Vec3(readNumber(ctx, items[0]), readNumber(ctx, items[1]), readNumber(ctx, items[2]));
+}
+
+int readNodeIndex(const Context& ctx, const Field& field, std::size_t node_count)
+{
+  const long long index = readInteger(ctx, field);
+  if (index < 0 || static_cast<unsigned long long>(index) >= node_count)
+    ctx.fail(field, "node index " + std::to_string(index) + " out of range; the body has " +
+                        std::to_string(node_count) + " nodes (0.." + std::to_string(node_count - 1) + ")");
+  return static_cast<int>(index);
+}
+
+}  // namespace soft_body_sim::scene_yaml
