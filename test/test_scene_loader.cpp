@@ -249,7 +249,7 @@ const BadScene kBadScenes[] = {
   { "UnknownTopLevelKey", R"(frame: world
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
-    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, physics, bodies" } },
+    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, physics, planes, bodies" } },
   { "UnknownPhysicsKey", R"(physics:
   dt: 0.01
   timestep: 0.01
@@ -772,7 +772,7 @@ bodies: []
   { "TopLevelIsAList", R"(- name: b
   type: custom
 )",
-    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, physics, bodies", "a list" } },
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, physics, planes, bodies", "a list" } },
   { "TopLevelIsAScalar", R"(hello
 )",
     "bad.yaml:1: (top level)", { "must be a YAML mapping", "'hello'" } },

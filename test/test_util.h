@@ -34,7 +34,9 @@ inline SceneDef oneBodyScene(IntegratorType integrator, double dt)
   scene.physics.integrator = integrator;
   scene.physics.step.dt = dt;
   scene.physics.gravity = Vec3::Zero();
-  scene.bodies.push_back(BodyDef{ "body", "custom", {}, {}, {} });
+  BodyDef body;
+  body.name = "body";
+  scene.bodies.push_back(body);
   return scene;
 }
 

@@ -28,9 +28,17 @@ World buildWorld(const SceneDef& scene)
   Model model;
   model.gravity = scene.physics.gravity;
   model.drag = scene.physics.drag;
+  for (Plane plane : scene.planes)
+  {
+    if (!(plane.normal.norm() > 0.0))
+      throw std::invalid_argument("plane normal must not be zero");
+    plane.normal.normalize();
+    model.planes.push_back(plane);
+  }
   model.mass.resize(node_count);
   model.inverse_mass.resize(node_count);
   State state;
+  std::vector<BodyController> controllers;
   state.position.resize(3, node_count);
   state.velocity.resize(3, node_count);
 
@@ -58,10 +66,19 @@ World buildWorld(const SceneDef& scene)
       const int b = globalIndex(body, first, c.b);
       model.constraints.push_back({ a, b, restLengthOr(c.rest_length, state, a, b), c.compliance });
     }
+    for (const AnchorDef& anchor : body.anchors)
+    {
+      const int node = globalIndex(body, first, anchor.node);
+      model.inverse_mass[node] = 0.0;
+      model.anchors.push_back({ body.name, anchor.name, node });
+    }
+    if (body.controller)
+      controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });
     model.bodies.push_back({ body.name, first, count });
     first += count;
   }
-  return World(std::move(model), std::move(state), scene.physics.integrator, scene.physics.step);
+  return World(std::move(model), std::move(state), scene.physics.integrator, scene.physics.step,
+               std::move(controllers));
 }
 
 }  // namespace soft_body_sim

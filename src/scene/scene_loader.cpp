@@ -8,6 +8,7 @@
 #include <set>
 #include <utility>
 
+#include "body_readers.h"
 #include "yaml_reader.h"
 
 namespace soft_body_sim
@@ -16,13 +17,10 @@ namespace
 {
 using namespace scene_yaml;
 
-const Keys kSceneKeys = { "frame_id", "physics", "bodies" };
+const Keys kSceneKeys = { "frame_id", "physics", "planes", "bodies" };
 const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag" };
-const Keys kBodyTypes = { "custom" };
-const Keys kCustomBodyKeys = { "name", "type", "nodes", "springs", "constraints" };
-const Keys kNodeKeys = { "position", "mass", "velocity", "pinned" };
-const Keys kSpringKeys = { "nodes", "stiffness", "damping", "rest_length" };
-const Keys kConstraintKeys = { "nodes", "compliance", "rest_length" };
+const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
+const Keys kAnchorKeys = { "name", "node" };
 
 // --- scene parts -------------------------------------------------------------------------------
 
@@ -54,72 +52,49 @@ PhysicsDef readPhysics(const Context& ctx, const Field& field)
   return physics;
 }
 
-NodeDef readNode(const Context& ctx, const Field& field)
+Plane readPlane(const Context& ctx, const Field& field)
 {
-  requireMap(ctx, field, kNodeKeys);
-  NodeDef node;
-  node.position = readVec3(ctx, requiredKey(ctx, field, "position"));
-  node.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
-  if (const std::optional<Field> value = optionalKey(field, "velocity"))
-    node.velocity = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "pinned"))
-    node.pinned = readBool(ctx, *value);
-  return node;
+  requireMap(ctx, field, kPlaneKeys);
+  Plane plane;
+  plane.point = readVec3(ctx, requiredKey(ctx, field, "point"));
+  const Field normal = requiredKey(ctx, field, "normal");
+  plane.normal = readVec3(ctx, normal);
+  if (!(plane.normal.norm() > 1e-12))
+    ctx.fail(normal, "must not be the zero vector");
+  if (const std::optional<Field> value = optionalKey(field, "restitution"))
+  {
+    plane.restitution = readNonNegative(ctx, *value);
+    if (plane.restitution > 1.0)
+      ctx.fail(*value, "must be in [0, 1], got " + value->node.Scalar());
+  }
+  if (const std::optional<Field> value = optionalKey(field, "friction"))
+    plane.friction = readNonNegative(ctx, *value);
+  return plane;
 }
 
-/// The `nodes` and `rest_length` keys that springs and constraints share.
-template <typename LinkDef>
-void readLinkEnds(const Context& ctx, const Field& field, std::size_t node_count, LinkDef& link)
+/// `anchors: [{name, node}]`, read after the body's type has expanded it, since `node` indexes the
+/// expanded body; a negative index counts from the end (-1 is the last node).
+void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
 {
-  const Field ends = requiredKey(ctx, field, "nodes");
-  const std::vector<Field> items = requireListOfSize(ctx, ends, 2, "node indices");
-  link.a = readNodeIndex(ctx, items[0], node_count);
-  link.b = readNodeIndex(ctx, items[1], node_count);
-  if (link.a == link.b)
-    ctx.fail(ends, "connects node " + std::to_string(link.a) + " to itself");
-  if (const std::optional<Field> value = optionalKey(field, "rest_length"))
-    link.rest_length = readNonNegative(ctx, *value);
-}
-
-SpringDef readSpring(const Context& ctx, const Field& field, std::size_t node_count)
-{
-  requireMap(ctx, field, kSpringKeys);
-  SpringDef spring;
-  readLinkEnds(ctx, field, node_count, spring);
-  spring.stiffness = readPositive(ctx, requiredKey(ctx, field, "stiffness"));
-  if (const std::optional<Field> value = optionalKey(field, "damping"))
-    spring.damping = readNonNegative(ctx, *value);
-  return spring;
-}
-
-ConstraintDef readConstraint(const Context& ctx, const Field& field, std::size_t node_count)
-{
-  requireMap(ctx, field, kConstraintKeys);
-  ConstraintDef constraint;
-  readLinkEnds(ctx, field, node_count, constraint);
-  if (const std::optional<Field> value = optionalKey(field, "compliance"))
-    constraint.compliance = readNonNegative(ctx, *value);
-  return constraint;
-}
-
-BodyDef readCustomBody(const Context& ctx, const Field& field)
-{
-  requireMap(ctx, field, kCustomBodyKeys);
-  BodyDef body;
-  body.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
-  body.type = "custom";
-  const Field nodes = requiredKey(ctx, field, "nodes");
-  for (const Field& item : requireList(ctx, nodes))
-    body.nodes.push_back(readNode(ctx, item));
-  if (body.nodes.empty())
-    ctx.fail(nodes, "must not be empty; a body needs at least one node");
-  if (const std::optional<Field> springs = optionalKey(field, "springs"))
-    for (const Field& item : requireList(ctx, *springs))
-      body.springs.push_back(readSpring(ctx, item, body.nodes.size()));
-  if (const std::optional<Field> constraints = optionalKey(field, "constraints"))
-    for (const Field& item : requireList(ctx, *constraints))
-      body.constraints.push_back(readConstraint(ctx, item, body.nodes.size()));
-  return body;
+  const std::size_t count = body.nodes.size();
+  for (const Field& item : requireList(ctx, field))
+  {
+    requireMap(ctx, item, kAnchorKeys);
+    AnchorDef anchor;
+    const Field name = requiredKey(ctx, item, "name");
+    anchor.name = readNonEmptyString(ctx, name);
+    for (const AnchorDef& other : body.anchors)
+      if (other.name == anchor.name)
+        ctx.fail(name, "duplicate anchor name " + quoted(anchor.name));
+    const Field node = requiredKey(ctx, item, "node");
+    const long long index = readInteger(ctx, node);
+    const long long n = static_cast<long long>(count);
+    if (index < -n || index >= n)
+      ctx.fail(node, "node index " + std::to_string(index) + " out of range; the body has " + std::to_string(count) +
+                         " nodes (" + std::to_string(-n) + ".." + std::to_string(n - 1) + ")");
+    anchor.node = static_cast<int>(index < 0 ? index + n : index);
+    body.anchors.push_back(anchor);
+  }
 }
 
 BodyDef readBody(const Context& ctx, const Field& field)
@@ -128,9 +103,21 @@ BodyDef readBody(const Context& ctx, const Field& field)
   // The type decides which other keys are allowed, so it is checked before them.
   const Field type = requiredKey(ctx, field, "type");
   const std::string name = readNonEmptyString(ctx, type);
-  if (name != "custom")
-    ctx.fail(type, "unknown body type " + quoted(name) + "; valid types: " + join(kBodyTypes));
-  return readCustomBody(ctx, field);
+  Keys names;
+  for (const BodyType& body_type : bodyTypes())
+  {
+    if (name == body_type.name)
+    {
+      BodyDef body = body_type.read(ctx, field);
+      body.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
+      body.type = name;
+      if (const std::optional<Field> anchors = optionalKey(field, "anchors"))
+        readAnchors(ctx, *anchors, body);
+      return body;
+    }
+    names.push_back(body_type.name);
+  }
+  ctx.fail(type, "unknown body type " + quoted(name) + "; valid types: " + join(names));
 }
 
 SceneDef readScene(const Context& ctx, const Field& root)
@@ -144,6 +131,9 @@ SceneDef readScene(const Context& ctx, const Field& root)
     scene.frame_id = readNonEmptyString(ctx, *value);
   if (const std::optional<Field> value = optionalKey(root, "physics"))
     scene.physics = readPhysics(ctx, *value);
+  if (const std::optional<Field> planes = optionalKey(root, "planes"))
+    for (const Field& item : requireList(ctx, *planes))
+      scene.planes.push_back(readPlane(ctx, item));
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error

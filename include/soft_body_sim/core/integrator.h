@@ -35,9 +35,9 @@ public:
   /// Advances `state` by h [s]. Pinned nodes (inverse mass 0) are never moved: their position and
   /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
   virtual void step(const Model& model, State& state, double h, int iterations) = 0;
-  /// Forgets any history (previous positions, cached accelerations); call after the state was changed
-  /// from outside, e.g. a reset or a teleported node.
-  virtual void restart() {}
+  /// The state was changed from outside the integrator (an anchor or controller moved its nodes, a
+  /// plane contact changed a velocity, a node was set): drop anything cached from the old state.
+  virtual void invalidate() {}
 };
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type);

@@ -43,6 +43,24 @@ struct BodyRange
   int count = 0;
 };
 
+/// A wall or floor: the half-space (x - point) . normal >= 0 is free space, nodes are pushed out of the
+/// other side. Contacts bounce with `restitution` and slide with Coulomb `friction`.
+struct Plane
+{
+  Vec3 point = Vec3::Zero();           ///< a point on the plane [m]
+  Vec3 normal = Vec3::UnitZ();         ///< unit normal pointing into free space
+  double restitution = 0.0;            ///< normal speed kept after a bounce, in [0, 1]
+  double friction = 0.0;               ///< Coulomb coefficient [-], >= 0
+};
+
+/// A named node of a body that the caller moves kinematically (its node is pinned).
+struct Anchor
+{
+  std::string body;
+  std::string name;
+  int node = 0;  ///< global node index
+};
+
 /// Everything that stays fixed while a scene runs. Pinned node = inverse mass 0: no force moves it;
 /// only the caller (an anchor) does.
 struct Model
@@ -52,6 +70,8 @@ struct Model
   std::vector<Spring> springs;
   std::vector<DistanceConstraint> constraints;
   std::vector<BodyRange> bodies;
+  std::vector<Plane> planes;
+  std::vector<Anchor> anchors;
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  ///< [m/s^2]
   double drag = 0.0;                      ///< linear air drag [1/s]: a -= drag * v on free nodes
 

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "soft_body_sim/core/controller.h"
 #include "soft_body_sim/core/integrator.h"
 #include "soft_body_sim/core/model.h"
 #include "soft_body_sim/core/world.h"
@@ -37,6 +38,15 @@ struct ConstraintDef
   std::optional<double> rest_length;     ///< [m]; default: the initial distance
 };
 
+/// A named node that the caller moves (World::moveAnchor); the node is pinned.
+struct AnchorDef
+{
+  std::string name;
+  int node = 0;  ///< node index within the body
+};
+
+/// Any body, as nodes, springs and constraints. Generated body types (rope, cloth, ...) expand into
+/// this form; procedurally animated ones add a controller that drives their pinned nodes.
 struct BodyDef
 {
   std::string name;
@@ -44,6 +54,8 @@ struct BodyDef
   std::vector<NodeDef> nodes;
   std::vector<SpringDef> springs;
   std::vector<ConstraintDef> constraints;
+  std::vector<AnchorDef> anchors;
+  ControllerFactory controller;  ///< empty for passive bodies
 };
 
 struct PhysicsDef
@@ -58,11 +70,13 @@ struct SceneDef
 {
   std::string frame_id = "world";  ///< fixed frame of the simulation
   PhysicsDef physics;
+  std::vector<Plane> planes;  ///< walls and floors every body collides with (normals need not be unit)
   std::vector<BodyDef> bodies;
 };
 
-/// Flattens the bodies into one node array (body k's nodes follow body k-1's) and returns the world.
-/// Expects a valid scene (the loader checks); throws std::invalid_argument on an index out of range.
+/// Flattens the bodies into one node array (body k's nodes follow body k-1's), pins anchored nodes,
+/// makes the controllers and returns the world. Expects a valid scene (the loader checks); throws
+/// std::invalid_argument on an index out of range or a zero plane normal.
 World buildWorld(const SceneDef& scene);
 
 }  // namespace soft_body_sim

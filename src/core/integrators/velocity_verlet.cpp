@@ -35,7 +35,7 @@ public:
     has_acceleration_ = model.constraints.empty();
   }
 
-  void restart() override { has_acceleration_ = false; }
+  void invalidate() override { has_acceleration_ = false; }
 
 private:
   bool has_acceleration_ = false;

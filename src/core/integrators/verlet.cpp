@@ -7,47 +7,43 @@ namespace
 {
 /// Position (Stoermer) Verlet as Jakobsen uses it, with constraint relaxation after the move:
 ///   x_{n+1} = 2 x_n - x_{n-1} + h^2 a(x_n, v_n)
-/// Started with second-order accuracy, x_1 = x_0 + h v_0 + h^2/2 a_0. Damping and drag need a
-/// velocity, estimated from positions to second order:
-///   v_{n+1} = (x_{n+1} - x_n) / h + h/2 a_n
-/// (Taylor: (x_{n+1} - x_n)/h = v_{n+1} - h/2 a_{n+1} + O(h^2) and a_{n+1} = a_n + O(h)).
-/// The recurrence needs a constant h: a new h restarts it from (x, v).
+/// Damping and drag need a velocity, estimated from positions to second order:
+///   v_n = (x_n - x_{n-1}) / h + h/2 a_{n-1}
+/// (Taylor: (x_n - x_{n-1})/h = v_n - h/2 a_n + O(h^2) and a_n = a_{n-1} + O(h)). The history
+/// x_{n-1} is kept through that estimate, x_n - x_{n-1} = h v_n - h^2/2 a_{n-1}, so the update reads
+///   x_{n+1} = x_n + h v_n + h^2 (a_n - a_{n-1} / 2)
+/// which is the same recurrence, and a velocity changed from outside (a plane contact, an anchor's
+/// pull) enters the next step as it should. Started with second-order accuracy: a_{-1} = a_0 gives
+/// x_1 = x_0 + h v_0 + h^2/2 a_0. The recurrence needs a constant h: a new h starts it again.
 class Verlet final : public Integrator
 {
 public:
   void step(const Model& model, State& state, double h, int iterations) override
   {
-    if (has_history_ && h != h_)
-      has_history_ = false;
     computeAccelerations(model, state.position, state.velocity, force_, acceleration_);
-    if (!has_history_)
-      previous_ = state.position;
-    for (int i = 0; i < model.nodeCount(); ++i)
-    {
-      if (!model.isFree(i))
-        continue;
-      const Vec3 x = state.position.col(i);
-      const Vec3 displacement = has_history_ ? Vec3(x - previous_.col(i)) : Vec3(h * state.velocity.col(i));
-      const double a_factor = has_history_ ? h * h : 0.5 * h * h;
-      state.position.col(i) = x + displacement + a_factor * acceleration_.col(i);
-      previous_.col(i) = x;
-    }
-    projectConstraints(model, h, iterations, previous_, state.position, lambda_);
+    if (!has_history_ || h != h_)
+      previous_acceleration_ = acceleration_;
+    start_ = state.position;
     for (int i = 0; i < model.nodeCount(); ++i)
       if (model.isFree(i))
-        state.velocity.col(i) = (state.position.col(i) - previous_.col(i)) / h + 0.5 * h * acceleration_.col(i);
+        state.position.col(i) +=
+            h * state.velocity.col(i) + h * h * (acceleration_.col(i) - 0.5 * previous_acceleration_.col(i));
+    projectConstraints(model, h, iterations, start_, state.position, lambda_);
+    for (int i = 0; i < model.nodeCount(); ++i)
+      if (model.isFree(i))
+        state.velocity.col(i) = (state.position.col(i) - start_.col(i)) / h + 0.5 * h * acceleration_.col(i);
+    previous_acceleration_.swap(acceleration_);
     has_history_ = true;
     h_ = h;
   }
 
-  void restart() override { has_history_ = false; }
-
 private:
   bool has_history_ = false;
   double h_ = 0.0;
-  NodeArray previous_;  ///< x_{n-1} [m] (pinned columns unused)
+  NodeArray start_;                  ///< x_n [m]
   NodeArray force_;
-  NodeArray acceleration_;
+  NodeArray acceleration_;           ///< a_n [m/s^2]
+  NodeArray previous_acceleration_;  ///< a_{n-1} [m/s^2]
   Eigen::VectorXd lambda_;
 };
 }  // namespace

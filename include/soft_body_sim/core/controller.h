@@ -1,0 +1,31 @@
+// Procedurally animated bodies (the creature, Bezier limbs): each runs its own small dynamics, as its
+// seed describes, and drives its nodes kinematically. Its nodes are pinned in the Model, so no
+// integrator moves them, while springs attached to them (tendrils) feel their motion.
+#pragma once
+
+#include <functional>
+#include <memory>
+
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+class Controller
+{
+public:
+  virtual ~Controller() = default;
+  /// Advances the procedural motion by dt [s] and writes the positions [m] and velocities [m/s] of its
+  /// nodes into `state`; it may read any node (e.g. a root following a torso).
+  virtual void step(double dt, State& state) = 0;
+  /// Sets the point [m] the body moves toward; returns false if this body takes no target.
+  virtual bool setTarget(const Vec3& target)
+  {
+    (void)target;
+    return false;
+  }
+};
+
+/// Makes the controller of a body whose node 0 has the global index `first_node`.
+using ControllerFactory = std::function<std::unique_ptr<Controller>(int first_node)>;
+
+}  // namespace soft_body_sim

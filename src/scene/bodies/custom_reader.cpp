@@ -1,0 +1,80 @@
+// `type: custom`: nodes, springs and constraints listed one by one.
+#include "../body_readers.h"
+
+namespace soft_body_sim::scene_yaml
+{
+namespace
+{
+const Keys kNodeKeys = { "position", "mass", "velocity", "pinned" };
+const Keys kSpringKeys = { "nodes", "stiffness", "damping", "rest_length" };
+const Keys kConstraintKeys = { "nodes", "compliance", "rest_length" };
+
+NodeDef readNode(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, kNodeKeys);
+  NodeDef node;
+  node.position = readVec3(ctx, requiredKey(ctx, field, "position"));
+  node.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
+  if (const std::optional<Field> value = optionalKey(field, "velocity"))
+    node.velocity = readVec3(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "pinned"))
+    node.pinned = readBool(ctx, *value);
+  return node;
+}
+
+/// The `nodes` and `rest_length` keys that springs and constraints share.
+template <typename LinkDef>
+void readLinkEnds(const Context& ctx, const Field& field, std::size_t node_count, LinkDef& link)
+{
+  const Field ends = requiredKey(ctx, field, "nodes");
+  const std::vector<Field> items = requireListOfSize(ctx, ends, 2, "node indices");
+  link.a = readNodeIndex(ctx, items[0], node_count);
+  link.b = readNodeIndex(ctx, items[1], node_count);
+  if (link.a == link.b)
+    ctx.fail(ends, "connects node " + std::to_string(link.a) + " to itself");
+  if (const std::optional<Field> value = optionalKey(field, "rest_length"))
+    link.rest_length = readNonNegative(ctx, *value);
+}
+
+SpringDef readSpring(const Context& ctx, const Field& field, std::size_t node_count)
+{
+  requireMap(ctx, field, kSpringKeys);
+  SpringDef spring;
+  readLinkEnds(ctx, field, node_count, spring);
+  spring.stiffness = readPositive(ctx, requiredKey(ctx, field, "stiffness"));
+  if (const std::optional<Field> value = optionalKey(field, "damping"))
+    spring.damping = readNonNegative(ctx, *value);
+  return spring;
+}
+
+ConstraintDef readConstraint(const Context& ctx, const Field& field, std::size_t node_count)
+{
+  requireMap(ctx, field, kConstraintKeys);
+  ConstraintDef constraint;
+  readLinkEnds(ctx, field, node_count, constraint);
+  if (const std::optional<Field> value = optionalKey(field, "compliance"))
+    constraint.compliance = readNonNegative(ctx, *value);
+  return constraint;
+}
+
+}  // namespace
+
+BodyDef readCustomBody(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, withCommonBodyKeys({ "nodes", "springs", "constraints" }));
+  BodyDef body;
+  const Field nodes = requiredKey(ctx, field, "nodes");
+  for (const Field& item : requireList(ctx, nodes))
+    body.nodes.push_back(readNode(ctx, item));
+  if (body.nodes.empty())
+    ctx.fail(nodes, "must not be empty; a body needs at least one node");
+  if (const std::optional<Field> springs = optionalKey(field, "springs"))
+    for (const Field& item : requireList(ctx, *springs))
+      body.springs.push_back(readSpring(ctx, item, body.nodes.size()));
+  if (const std::optional<Field> constraints = optionalKey(field, "constraints"))
+    for (const Field& item : requireList(ctx, *constraints))
+      body.constraints.push_back(readConstraint(ctx, item, body.nodes.size()));
+  return body;
+}
+
+}  // namespace soft_body_sim::scene_yaml
