@@ -1,0 +1,31 @@
+// A rope or string (spring-string-tutorial.txt): a straight chain of equal-mass nodes joined by damped
+// springs, optionally stiffened against bending by springs to second neighbours.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "soft_body_sim/core/scene_def.h"
+
+namespace soft_body_sim
+{
+struct RopeDef
+{
+  int nodes = 20;                     ///< node count, >= 2
+  Vec3 from = Vec3::Zero();           ///< first node [m]
+  Vec3 to = Vec3(1.0, 0.0, 0.0);      ///< last node [m]; segments start at rest, |to - from| / (nodes - 1)
+  double mass = 0.1;                  ///< total mass [kg], spread equally over the nodes
+  double stiffness = 1000.0;          ///< segment spring stiffness [N/m]
+  double damping = 0.0;               ///< segment dashpot [N s/m]
+  double bending = 0.0;               ///< stiffness [N/m] of springs to second neighbours; 0 = none
+  double bending_damping = 0.0;       ///< their dashpot [N s/m]
+  std::vector<int> pinned;            ///< pinned node indices; negative counts from the end (-1 = last)
+};
+
+/// The rope as nodes and springs (type "rope"); throws std::invalid_argument on a bad definition.
+BodyDef buildRope(const std::string& name, const RopeDef& rope);
+
+/// A pinned index made non-negative: i < 0 counts from the end; throws std::out_of_range if outside.
+int resolveNodeIndex(int index, int node_count);
+
+}  // namespace soft_body_sim
