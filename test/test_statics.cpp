@@ -5,14 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include "catenary.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test
 {
 namespace
 {
-constexpr double kG = 9.81;  // [m/s^2]
-
 /// Runs until the speed of every node is below `speed` [m/s] or `max_steps` pass; returns the steps run.
 long settle(World& world, double speed, long max_steps)
 {
@@ -39,7 +38,7 @@ struct VerticalChain
   SceneDef scene(IntegratorType integrator, double dt, int iterations) const
   {
     SceneDef s = oneBodyScene(integrator, dt);
-    s.physics.gravity = Vec3(0, 0, -kG);
+    s.physics.gravity = Vec3(0, 0, -kGravity);
     s.physics.drag = 2.0;
     s.physics.step.iterations = iterations;
     BodyDef& body = s.bodies[0];
@@ -54,7 +53,7 @@ struct VerticalChain
   {
     Eigen::Matrix3Xd x = Eigen::Matrix3Xd::Zero(3, nodes);
     for (int j = 1; j < nodes; ++j)
-      x(2, j) = x(2, j - 1) - (rest + (nodes - j) * node_mass * kG / stiffness);
+      x(2, j) = x(2, j - 1) - (rest + (nodes - j) * node_mass * kGravity / stiffness);
     return x;
   }
 };
@@ -69,7 +68,7 @@ TEST(VerticalChain, ImplicitEulerSettlesOnTheClosedFormStretch)
   EXPECT_TRUE(expectNear(world.state().position, chain.exact(), 1e-9));
   // The total stretch, (N - 1) N m g / (2 k), as a single figure.
   const double length = -world.state().position(2, chain.nodes - 1);
-  const double stretch = chain.nodes * (chain.nodes - 1) * chain.node_mass * kG / (2.0 * chain.stiffness);
+  const double stretch = chain.nodes * (chain.nodes - 1) * chain.node_mass * kGravity / (2.0 * chain.stiffness);
   EXPECT_NEAR(length, (chain.nodes - 1) * chain.rest + stretch, 1e-9);
 }
 
@@ -97,39 +96,13 @@ TEST(VerticalChain, XpbdWithConvergedIterationsMatchesTheClosedForm)
   EXPECT_TRUE(expectNear(world.state().position, chain.exact(), 1e-9));
 }
 
-// The elastic discrete catenary. Interior node j (mass m) is in equilibrium when the tension vectors of
-// its two segments differ by its weight: T_j = T_{j-1} + (0, 0, m g). With horizontal tension H and a
-// symmetric chain, T_j = (H, 0, (j - (N - 2) / 2) m g), and segment j has length L + |T_j| / k along
-// T_j / |T_j|. The span sum_j s_j . x grows monotonically with H, so bisection finds H to machine
-// precision; the node positions follow by summing the segments.
-Eigen::Matrix3Xd discreteCatenary(int nodes, double node_mass, double stiffness, double rest, double span)
-{
-  auto shape = [&](double horizontal_tension) {
-    Eigen::Matrix3Xd x = Eigen::Matrix3Xd::Zero(3, nodes);
-    for (int j = 0; j + 1 < nodes; ++j)
-    {
-      const Vec3 tension(horizontal_tension, 0.0, (j - (nodes - 2) / 2.0) * node_mass * kG);
-      const double length = rest + tension.norm() / stiffness;
-      x.col(j + 1) = x.col(j) + length * tension.normalized();
-    }
-    return x;
-  };
-  double low = 0.0, high = 1e6;
-  for (int k = 0; k < 200; ++k)
-  {
-    const double mid = 0.5 * (low + high);
-    (shape(mid)(0, nodes - 1) < span ? low : high) = mid;
-  }
-  return shape(0.5 * (low + high));
-}
-
 TEST(HangingChain, SettlesOnTheElasticDiscreteCatenary)
 {
   // 1 m, 0.1 kg, 21 nodes, pinned at both ends 0.8 m apart; released from a V of the rest length.
   const int nodes = 21;
   const double mass = 0.1 / nodes, stiffness = 200.0, rest = 1.0 / (nodes - 1), span = 0.8;
   SceneDef scene = oneBodyScene(IntegratorType::ImplicitEuler, 0.01);
-  scene.physics.gravity = Vec3(0, 0, -kG);
+  scene.physics.gravity = Vec3(0, 0, -kGravity);
   scene.physics.drag = 1.0;
   scene.physics.step.iterations = 2;
   BodyDef& body = scene.bodies[0];

@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <vector>
 
 #include "soft_body_sim/core/model.h"
 
@@ -22,6 +23,12 @@ public:
   {
     (void)target;
     return false;
+  }
+  /// Polylines [m] to draw for this body beyond its nodes and springs (a limb's sampled Bezier curve).
+  virtual std::vector<std::vector<Vec3>> curves(const State& state) const
+  {
+    (void)state;
+    return {};
   }
 };
 

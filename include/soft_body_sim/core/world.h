@@ -40,6 +40,7 @@ public:
   const State& state() const { return state_; }
   const StepSettings& settings() const { return settings_; }
   IntegratorType integrator() const { return integrator_type_; }
+  const std::vector<BodyController>& controllers() const { return controllers_; }
 
   /// Index of the anchor `anchor` of body `body` in model().anchors, or nullopt.
   std::optional<int> findAnchor(const std::string& body, const std::string& anchor) const;
