@@ -784,6 +784,60 @@ bodies: []
 bodies: [{name: c, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
     "bad.yaml:3: (top level)", { "second YAML document" } },
+  // --- planes and anchors
+  { "PlaneWithZeroNormal", R"(planes:
+  - {point: [0, 0, 0], normal: [0, 0, 0]}
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
+)",
+    "bad.yaml:2: planes[0].normal", { "zero vector" } },
+  { "PlaneRestitutionAboveOne", R"(planes:
+  - {point: [0, 0, 0], normal: [0, 0, 1], restitution: 1.5}
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
+)",
+    "bad.yaml:2: planes[0].restitution", { "must be in [0, 1]", "1.5" } },
+  { "PlaneNegativeFriction", R"(planes:
+  - {point: [0, 0, 0], normal: [0, 0, 1], friction: -0.1}
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
+)",
+    "bad.yaml:2: planes[0].friction", { "must be >= 0" } },
+  { "PlaneMissingPoint", R"(planes:
+  - {normal: [0, 0, 1]}
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
+)",
+    "bad.yaml:2: planes[0].point", { "missing required key" } },
+  { "PlaneUnknownKey", R"(planes:
+  - {point: [0, 0, 0], normal: [0, 0, 1], bounce: 1}
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
+)",
+    "bad.yaml:2: planes[0].bounce", { "unknown key 'bounce'", "point, normal, restitution, friction" } },
+  { "AnchorNodeOutOfRange", R"(bodies:
+  - name: b
+    type: custom
+    nodes: [{position: [0, 0, 0], mass: 1}, {position: [1, 0, 0], mass: 1}]
+    anchors: [{name: end, node: 2}]
+)",
+    "bad.yaml:5: bodies[0].anchors[0].node", { "node index 2 out of range", "-2..1" } },
+  { "AnchorNegativeIndexOutOfRange", R"(bodies:
+  - name: b
+    type: custom
+    nodes: [{position: [0, 0, 0], mass: 1}, {position: [1, 0, 0], mass: 1}]
+    anchors: [{name: end, node: -3}]
+)",
+    "bad.yaml:5: bodies[0].anchors[0].node", { "node index -3 out of range" } },
+  { "AnchorDuplicateName", R"(bodies:
+  - name: b
+    type: custom
+    nodes: [{position: [0, 0, 0], mass: 1}, {position: [1, 0, 0], mass: 1}]
+    anchors: [{name: end, node: 0}, {name: end, node: 1}]
+)",
+    "bad.yaml:5: bodies[0].anchors[1].name", { "duplicate anchor name 'end'" } },
+  { "AnchorMissingNode", R"(bodies:
+  - name: b
+    type: custom
+    nodes: [{position: [0, 0, 0], mass: 1}]
+    anchors: [{name: end}]
+)",
+    "bad.yaml:5: bodies[0].anchors[0].node", { "missing required key" } },
   { "MultiLineValueStaysOneLine", R"(physics:
   integrator: "semi\nimplicit"
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
@@ -803,6 +857,39 @@ TEST_P(BadSceneTest, IsRejectedWithSourceLineKeyPathAndReason)
 
 INSTANTIATE_TEST_SUITE_P(SceneLoader, BadSceneTest, ::testing::ValuesIn(kBadScenes),
                          [](const ::testing::TestParamInfo<BadScene>& info) { return std::string(info.param.name); });
+
+TEST(SceneLoader, PlanesAndAnchorsAreRead)
+{
+  const SceneDef scene = parseScene(R"(planes:
+  - {point: [0, 0, -1], normal: [0, 0, 2], restitution: 0.5, friction: 0.3}
+  - {point: [1, 0, 0], normal: [-1, 0, 0]}
+bodies:
+  - name: b
+    type: custom
+    nodes: [{position: [0, 0, 0], mass: 1}, {position: [1, 0, 0], mass: 1}, {position: [2, 0, 0], mass: 1}]
+    anchors: [{name: first, node: 0}, {name: last, node: -1}]
+)",
+                                    "planes.yaml");
+  ASSERT_EQ(scene.planes.size(), 2u);
+  expectVec3(scene.planes[0].point, 0, 0, -1);
+  expectVec3(scene.planes[0].normal, 0, 0, 2);  // normalised when the world is built
+  EXPECT_EQ(scene.planes[0].restitution, 0.5);
+  EXPECT_EQ(scene.planes[0].friction, 0.3);
+  EXPECT_EQ(scene.planes[1].restitution, 0.0);
+  EXPECT_EQ(scene.planes[1].friction, 0.0);
+  const BodyDef& body = scene.bodies[0];
+  ASSERT_EQ(body.anchors.size(), 2u);
+  EXPECT_EQ(body.anchors[0].name, "first");
+  EXPECT_EQ(body.anchors[0].node, 0);
+  EXPECT_EQ(body.anchors[1].node, 2);
+
+  // Anchored nodes are pinned in the world.
+  const World world = buildWorld(scene);
+  EXPECT_EQ(world.model().inverse_mass[0], 0.0);
+  EXPECT_EQ(world.model().inverse_mass[1], 1.0);
+  EXPECT_EQ(world.model().inverse_mass[2], 0.0);
+  EXPECT_EQ(world.model().planes[0].normal, Vec3(0, 0, 1));
+}
 
 // --- files -------------------------------------------------------------------------------------
 

@@ -33,5 +33,101 @@ TEST(Anchors, AnAnchoredNodeArrivesExactlyWhereItWasSentWithinOneStep)
   EXPECT_TRUE(world.state().velocity.col(4).isZero(0.0));
 }
 
+/// One free node of mass 1 kg above a floor z = 0 (the plane's normal given unnormalised on purpose).
+World nodeAboveFloor(IntegratorType integrator, double dt, const Vec3& position, const Vec3& velocity,
+                     double restitution, double friction)
+{
+  SceneDef scene = oneBodyScene(integrator, dt);
+  scene.physics.gravity = Vec3(0, 0, -9.81);
+  scene.planes = { Plane{ Vec3::Zero(), Vec3(0, 0, 3), restitution, friction } };
+  scene.bodies[0].nodes = { NodeDef{ position, 1.0, velocity, false } };
+  return buildWorld(scene);
+}
+
+TEST(Planes, ABounceKeepsTheRestitutionFractionOfTheImpactSpeed)
+{
+  // Dropped from H = 1 m: impact speed sqrt(2 g H); the first rebound leaves at e times that and rises
+  // to e^2 H. The contact is found at a step boundary, so the impact speed is off by at most g h and
+  // the apex by about v h: with h = 1e-4 s, 1e-3 m/s and 1e-3 m are generous.
+  const double restitution = 0.6, height = 1.0, g = 9.81, dt = 1e-4;
+  for (IntegratorType integrator : { IntegratorType::SemiImplicitEuler, IntegratorType::Verlet, IntegratorType::Xpbd })
+  {
+    World world = nodeAboveFloor(integrator, dt, Vec3(0, 0, height), Vec3::Zero(), restitution, 0.0);
+    double rebound_speed = 0.0, apex = 0.0;
+    bool bounced = false;
+    for (int n = 0; n < 20000; ++n)
+    {
+      const double vz_before = world.state().velocity(2, 0);
+      world.step();
+      const double vz = world.state().velocity(2, 0);
+      if (!bounced && vz_before < 0.0 && vz > 0.0)
+      {
+        bounced = true;
+        rebound_speed = vz;
+      }
+      if (bounced)
+      {
+        apex = std::max(apex, world.state().position(2, 0));
+        if (vz < 0.0)
+          break;
+      }
+    }
+    ASSERT_TRUE(bounced) << integratorName(integrator);
+    EXPECT_NEAR(rebound_speed, restitution * std::sqrt(2.0 * g * height), 2e-3) << integratorName(integrator);
+    EXPECT_NEAR(apex, restitution * restitution * height, 2e-3) << integratorName(integrator);
+  }
+}
+
+TEST(Planes, AFastNodeDoesNotTunnel)
+{
+  // 100 m/s at the default step moves 0.1 m per step: the half-space test still catches it.
+  for (IntegratorType integrator : { IntegratorType::SemiImplicitEuler, IntegratorType::Rk4, IntegratorType::Xpbd,
+                                     IntegratorType::ImplicitEuler })
+  {
+    World world = nodeAboveFloor(integrator, 1e-3, Vec3(0, 0, 0.25), Vec3(0, 0, -100), 0.0, 0.0);
+    for (int n = 0; n < 100; ++n)
+    {
+      world.step();
+      ASSERT_GE(world.state().position(2, 0), 0.0) << integratorName(integrator) << " step " << n;
+    }
+  }
+}
+
+TEST(Planes, CoulombFrictionStopsASlidingNodeAfterVSquaredOverTwoMuG)
+{
+  // A node sliding at v0 decelerates at mu g: it stops after v0^2 / (2 mu g) = 0.5097 m. Each step's
+  // contact removes exactly mu g h of tangential speed; the stop falls within one step, v0 h = 2e-3 m.
+  const double v0 = 2.0, mu = 0.4, g = 9.81, dt = 1e-3;
+  World world = nodeAboveFloor(IntegratorType::SemiImplicitEuler, dt, Vec3::Zero(), Vec3(v0, 0, 0), 0.0, mu);
+  for (int n = 0; n < 2000; ++n)
+    world.step();
+  EXPECT_NEAR(world.state().position(0, 0), v0 * v0 / (2.0 * mu * g), v0 * dt);
+  EXPECT_EQ(world.state().velocity(0, 0), 0.0);  // friction never reverses the sliding direction
+}
+
+TEST(Planes, ARestingNodeDoesNotJitter)
+{
+  // On the floor, each step gravity adds g h of approach speed, which is below the resting speed and is
+  // removed: the node stays on the plane and its kinetic energy stays below m (g h)^2 / 2.
+  const double dt = 1e-3, g = 9.81;
+  World world = nodeAboveFloor(IntegratorType::SemiImplicitEuler, dt, Vec3::Zero(), Vec3::Zero(), 0.9, 0.0);
+  for (int n = 0; n < 10000; ++n)
+  {
+    world.step();
+    ASSERT_LE(0.5 * world.state().velocity.col(0).squaredNorm(), 0.5 * (g * dt) * (g * dt)) << "step " << n;
+    ASSERT_NEAR(world.state().position(2, 0), 0.0, g * dt * dt) << "step " << n;
+  }
+}
+
+TEST(Planes, PinnedNodesAreLeftWhereTheyAre)
+{
+  SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);
+  scene.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.0 } };
+  scene.bodies[0].nodes = { NodeDef{ Vec3(0, 0, -1), 1.0, Vec3::Zero(), true } };
+  World world = buildWorld(scene);
+  world.step();
+  EXPECT_EQ(Vec3(world.state().position.col(0)), Vec3(0, 0, -1));
+}
+
 }  // namespace
 }  // namespace soft_body_sim::test
