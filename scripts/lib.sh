@@ -13,7 +13,7 @@ PACKAGES=(
   catkin python3-catkin-pkg ros-message-generation ros-message-runtime
   libstd-msgs-dev libgeometry-msgs-dev ros-std-msgs ros-geometry-msgs
   libeigen3-dev libyaml-cpp-dev
-  googletest libgtest-dev
+  googletest libgtest-dev libbenchmark-dev
 )
 
 log() { printf '[%s] %s\n' "$(basename "$0")" "$*" >&2; }
