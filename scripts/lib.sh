@@ -12,15 +12,21 @@ PACKAGES=(
   build-essential cmake python3
   catkin python3-catkin-pkg ros-message-generation ros-message-runtime
   libstd-msgs-dev libgeometry-msgs-dev ros-std-msgs ros-geometry-msgs
+  libvisualization-msgs-dev ros-visualization-msgs libstd-srvs-dev ros-std-srvs
+  libroscpp-dev libtf2-ros-dev libtf2-geometry-msgs-dev ros-tf2-msgs
+  python3-rostest librostest-dev python3-roslaunch python3-rostopic python3-rosbag
   libeigen3-dev libyaml-cpp-dev
   googletest libgtest-dev libbenchmark-dev
 )
+# What only the demo needs on top: rviz.
+DEMO_PACKAGES=(rviz)
 
 log() { printf '[%s] %s\n' "$(basename "$0")" "$*" >&2; }
 
+# install_missing [EXTRA_PACKAGE...]: installs whatever of PACKAGES and the extras is missing.
 install_missing() {
   local missing=() package
-  for package in "${PACKAGES[@]}"; do
+  for package in "${PACKAGES[@]}" "$@"; do
     dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
   done
   [ ${#missing[@]} -eq 0 ] && return 0

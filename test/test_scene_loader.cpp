@@ -249,7 +249,7 @@ const BadScene kBadScenes[] = {
   { "UnknownTopLevelKey", R"(frame: world
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
-    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, physics, planes, bodies" } },
+    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, rate, physics, planes, bodies" } },
   { "UnknownPhysicsKey", R"(physics:
   dt: 0.01
   timestep: 0.01
@@ -772,7 +772,7 @@ bodies: []
   { "TopLevelIsAList", R"(- name: b
   type: custom
 )",
-    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, physics, planes, bodies", "a list" } },
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, rate, physics, planes, bodies", "a list" } },
   { "TopLevelIsAScalar", R"(hello
 )",
     "bad.yaml:1: (top level)", { "must be a YAML mapping", "'hello'" } },
@@ -784,6 +784,10 @@ bodies: []
 bodies: [{name: c, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
     "bad.yaml:3: (top level)", { "second YAML document" } },
+  { "ZeroRate", R"(rate: 0
+bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
+)",
+    "bad.yaml:1: rate", { "must be > 0" } },
   // --- planes and anchors
   { "PlaneWithZeroNormal", R"(planes:
   - {point: [0, 0, 0], normal: [0, 0, 0]}
@@ -857,6 +861,13 @@ TEST_P(BadSceneTest, IsRejectedWithSourceLineKeyPathAndReason)
 
 INSTANTIATE_TEST_SUITE_P(SceneLoader, BadSceneTest, ::testing::ValuesIn(kBadScenes),
                          [](const ::testing::TestParamInfo<BadScene>& info) { return std::string(info.param.name); });
+
+TEST(SceneLoader, RateIsReadWithADefaultOfSixtyHertz)
+{
+  const char* const body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";
+  EXPECT_EQ(parseScene(body, "rate.yaml").rate, 60.0);
+  EXPECT_EQ(parseScene(std::string("rate: 25\n") + body, "rate.yaml").rate, 25.0);
+}
 
 TEST(SceneLoader, PlanesAndAnchorsAreRead)
 {

@@ -17,7 +17,7 @@ namespace
 {
 using namespace scene_yaml;
 
-const Keys kSceneKeys = { "frame_id", "physics", "planes", "bodies" };
+const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "bodies" };
 const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag" };
 const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
 const Keys kAnchorKeys = { "name", "node" };
@@ -129,6 +129,8 @@ SceneDef readScene(const Context& ctx, const Field& root)
   SceneDef scene;
   if (const std::optional<Field> value = optionalKey(root, "frame_id"))
     scene.frame_id = readNonEmptyString(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(root, "rate"))
+    scene.rate = readPositive(ctx, *value);
   if (const std::optional<Field> value = optionalKey(root, "physics"))
     scene.physics = readPhysics(ctx, *value);
   if (const std::optional<Field> planes = optionalKey(root, "planes"))

@@ -69,6 +69,7 @@ struct PhysicsDef
 struct SceneDef
 {
   std::string frame_id = "world";  ///< fixed frame of the simulation
+  double rate = 60.0;              ///< [Hz] at which the ROS node advances and publishes, > 0
   PhysicsDef physics;
   std::vector<Plane> planes;  ///< walls and floors every body collides with (normals need not be unit)
   std::vector<BodyDef> bodies;

@@ -1,0 +1,41 @@
+// Every conversion between the core and ROS messages, in one place (as grid_map's
+// GridMapRosConverter): markers and state out, poses in. Plain functions of plain data, unit-tested
+// without a ROS master.
+#pragma once
+
+#include <string>
+
+#include <geometry_msgs/Pose.h>
+#include <ros/time.h>
+#include <visualization_msgs/MarkerArray.h>
+
+#include "soft_body_sim/SimState.h"
+#include "soft_body_sim/core/world.h"
+
+namespace soft_body_sim
+{
+/// Step statistics reported with the state.
+struct StepStatistics
+{
+  double real_time_factor = 0.0;       ///< simulated seconds per wall second over the last tick [-]
+  double wall_seconds_per_step = 0.0;  ///< wall time of one physics step [s]
+};
+
+class RosConverter
+{
+public:
+  /// One namespace per body (its name): id 0 a SPHERE_LIST of its nodes in node order, id 1 a
+  /// LINE_LIST of its springs and constraints, ids 2.. a LINE_STRIP per curve of its controller (limbs).
+  /// Non-finite positions are never published: such a node is left out of the markers.
+  static visualization_msgs::MarkerArray toMarkers(const World& world, const std::string& frame_id,
+                                                   const ros::Time& stamp);
+
+  /// The state: per body its name, positions [m] and velocities [m/s], and the step statistics.
+  static SimState toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
+                          const StepStatistics& statistics);
+
+  /// The position [m] of a pose; false (and why) if any field of the pose is NaN or infinite.
+  static bool fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why);
+};
+
+}  // namespace soft_body_sim

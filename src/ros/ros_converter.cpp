@@ -1,0 +1,152 @@
+#include "soft_body_sim/ros/ros_converter.h"
+
+#include <cmath>
+
+namespace soft_body_sim
+{
+namespace
+{
+constexpr double kNodeDiameter = 0.02;  // [m] sphere size in rviz
+constexpr double kLineWidth = 0.005;    // [m]
+
+/// A distinct, stable colour per body index (golden-angle hues).
+std_msgs::ColorRGBA bodyColor(std::size_t body)
+{
+  const double hue = std::fmod(static_cast<double>(body) * 137.508, 360.0) / 60.0;
+  const double x = 1.0 - std::abs(std::fmod(hue, 2.0) - 1.0);
+  const double rgb[6][3] = { { 1, x, 0 }, { x, 1, 0 }, { 0, 1, x }, { 0, x, 1 }, { x, 0, 1 }, { 1, 0, x } };
+  const auto& c = rgb[static_cast<int>(hue) % 6];
+  std_msgs::ColorRGBA color;
+  color.r = static_cast<float>(0.2 + 0.8 * c[0]);
+  color.g = static_cast<float>(0.2 + 0.8 * c[1]);
+  color.b = static_cast<float>(0.2 + 0.8 * c[2]);
+  color.a = 1.0f;
+  return color;
+}
+
+visualization_msgs::Marker marker(const std::string& frame_id, const ros::Time& stamp, const std::string& ns, int id,
+                                  int type, double scale, const std_msgs::ColorRGBA& color)
+{
+  visualization_msgs::Marker m;
+  m.header.frame_id = frame_id;
+  m.header.stamp = stamp;
+  m.ns = ns;
+  m.id = id;
+  m.type = type;
+  m.action = visualization_msgs::Marker::ADD;
+  m.pose.orientation.w = 1.0;
+  m.scale.x = m.scale.y = m.scale.z = scale;
+  m.color = color;
+  return m;
+}
+
+geometry_msgs::Point point(const Vec3& p)
+{
+  geometry_msgs::Point out;
+  out.x = p.x();
+  out.y = p.y();
+  out.z = p.z();
+  return out;
+}
+
+/// A line from node a to node b if both ends are finite.
+void addSegment(const NodeArray& x, int a, int b, visualization_msgs::Marker& lines)
+{
+  if (!x.col(a).allFinite() || !x.col(b).allFinite())
+    return;
+  lines.points.push_back(point(x.col(a)));
+  lines.points.push_back(point(x.col(b)));
+}
+}  // namespace
+
+visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, const std::string& frame_id,
+                                                        const ros::Time& stamp)
+{
+  const Model& model = world.model();
+  const NodeArray& x = world.state().position;
+  visualization_msgs::MarkerArray array;
+  std::vector<int> body_of_node(static_cast<std::size_t>(model.nodeCount()));
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+  {
+    const BodyRange& body = model.bodies[b];
+    const std_msgs::ColorRGBA color = bodyColor(b);
+    visualization_msgs::Marker nodes =
+        marker(frame_id, stamp, body.name, 0, visualization_msgs::Marker::SPHERE_LIST, kNodeDiameter, color);
+    for (int i = body.first; i < body.first + body.count; ++i)
+    {
+      body_of_node[static_cast<std::size_t>(i)] = static_cast<int>(b);
+      if (x.col(i).allFinite())
+        nodes.points.push_back(point(x.col(i)));
+    }
+    array.markers.push_back(nodes);
+    array.markers.push_back(
+        marker(frame_id, stamp, body.name, 1, visualization_msgs::Marker::LINE_LIST, kLineWidth, color));
+  }
+  // Springs and constraints join nodes of one body; each goes to that body's LINE_LIST (index 2b + 1).
+  for (const Spring& s : model.springs)
+    addSegment(x, s.a, s.b, array.markers[2 * static_cast<std::size_t>(body_of_node[s.a]) + 1]);
+  for (const DistanceConstraint& c : model.constraints)
+    addSegment(x, c.a, c.b, array.markers[2 * static_cast<std::size_t>(body_of_node[c.a]) + 1]);
+
+  for (const BodyController& controlled : world.controllers())
+  {
+    const BodyRange& body = model.bodies[static_cast<std::size_t>(controlled.body)];
+    int id = 2;
+    for (const std::vector<Vec3>& curve : controlled.controller->curves(world.state()))
+    {
+      visualization_msgs::Marker strip = marker(frame_id, stamp, body.name, id++, visualization_msgs::Marker::LINE_STRIP,
+                                                2.0 * kLineWidth, bodyColor(static_cast<std::size_t>(controlled.body)));
+      for (const Vec3& p : curve)
+        if (p.allFinite())
+          strip.points.push_back(point(p));
+      array.markers.push_back(strip);
+    }
+  }
+  return array;
+}
+
+SimState RosConverter::toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
+                               const StepStatistics& statistics)
+{
+  SimState state;
+  state.header.frame_id = frame_id;
+  state.header.stamp = stamp;
+  state.real_time_factor = statistics.real_time_factor;
+  state.wall_seconds_per_step = statistics.wall_seconds_per_step;
+  for (const BodyRange& range : world.model().bodies)
+  {
+    BodyState body;
+    body.name = range.name;
+    for (int i = range.first; i < range.first + range.count; ++i)
+    {
+      body.positions.push_back(point(world.state().position.col(i)));
+      geometry_msgs::Vector3 v;
+      v.x = world.state().velocity(0, i);
+      v.y = world.state().velocity(1, i);
+      v.z = world.state().velocity(2, i);
+      body.velocities.push_back(v);
+    }
+    state.bodies.push_back(body);
+  }
+  return state;
+}
+
+bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why)
+{
+  const Vec3 p(pose.position.x, pose.position.y, pose.position.z);
+  const Eigen::Vector4d q(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w);
+  if (!p.allFinite())
+  {
+    why = "position is not finite";
+    return false;
+  }
+  if (!q.allFinite())
+  {
+    why = "orientation is not finite";
+    return false;
+  }
+  position = p;
+  return true;
+}
+
+}  // namespace soft_body_sim

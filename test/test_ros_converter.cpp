@@ -1,0 +1,123 @@
+// Message conversions as plain structs (no ROS master): markers, state and poses.
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "soft_body_sim/core/bodies/rope.h"
+#include "soft_body_sim/ros/ros_converter.h"
+#include "test_util.h"
+
+namespace soft_body_sim::test
+{
+namespace
+{
+World twoBodies()
+{
+  SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);
+  RopeDef rope;
+  rope.nodes = 4;
+  rope.from = Vec3(0, 0, 1);
+  rope.to = Vec3(0.3, 0, 1);
+  scene.bodies[0] = buildRope("rope", rope);
+  BodyDef pair;
+  pair.name = "pair";
+  pair.nodes = { NodeDef{ Vec3(1, 2, 3), 1.0, Vec3(0.5, 0, 0) }, NodeDef{ Vec3(1, 2, 4), 1.0 } };
+  pair.constraints = { ConstraintDef{ 0, 1, 0.0, std::nullopt } };
+  scene.bodies.push_back(pair);
+  return buildWorld(scene);
+}
+
+TEST(RosConverter, MarkersHaveOneNamespacePerBodyWithNodesAndLinks)
+{
+  const World world = twoBodies();
+  const ros::Time stamp(12.5);
+  const visualization_msgs::MarkerArray array = RosConverter::toMarkers(world, "map", stamp);
+  ASSERT_EQ(array.markers.size(), 4u);
+  const std::string names[] = { "rope", "pair" };
+  const std::size_t links[] = { 3, 1 };
+  for (std::size_t b = 0; b < 2; ++b)
+  {
+    const visualization_msgs::Marker& nodes = array.markers[2 * b];
+    const visualization_msgs::Marker& lines = array.markers[2 * b + 1];
+    EXPECT_EQ(nodes.ns, names[b]);
+    EXPECT_EQ(nodes.id, 0);
+    EXPECT_EQ(nodes.type, visualization_msgs::Marker::SPHERE_LIST);
+    EXPECT_EQ(lines.ns, names[b]);
+    EXPECT_EQ(lines.id, 1);
+    EXPECT_EQ(lines.type, visualization_msgs::Marker::LINE_LIST);
+    EXPECT_EQ(lines.points.size(), 2 * links[b]);
+    for (const visualization_msgs::Marker* m : { &nodes, &lines })
+    {
+      EXPECT_EQ(m->header.frame_id, "map");
+      EXPECT_EQ(m->header.stamp, stamp);
+      EXPECT_EQ(m->action, visualization_msgs::Marker::ADD);
+      EXPECT_EQ(m->pose.orientation.w, 1.0);
+      EXPECT_GT(m->scale.x, 0.0);
+      EXPECT_EQ(m->color.a, 1.0f);
+    }
+  }
+  // Node order: the rope's node 2 and the pair's node 1.
+  EXPECT_DOUBLE_EQ(array.markers[0].points[2].x, 0.2);
+  EXPECT_EQ(array.markers[2].points[1].z, 4.0);
+  // The rope's second spring joins nodes 1 and 2.
+  EXPECT_DOUBLE_EQ(array.markers[1].points[2].x, 0.1);
+  EXPECT_DOUBLE_EQ(array.markers[1].points[3].x, 0.2);
+}
+
+TEST(RosConverter, StateCarriesPositionsVelocitiesAndStatistics)
+{
+  const World world = twoBodies();
+  const SimState state = RosConverter::toState(world, "map", ros::Time(3.0), StepStatistics{ 0.98, 2e-5 });
+  EXPECT_EQ(state.header.frame_id, "map");
+  EXPECT_EQ(state.header.stamp, ros::Time(3.0));
+  EXPECT_EQ(state.real_time_factor, 0.98);
+  EXPECT_EQ(state.wall_seconds_per_step, 2e-5);
+  ASSERT_EQ(state.bodies.size(), 2u);
+  EXPECT_EQ(state.bodies[0].name, "rope");
+  ASSERT_EQ(state.bodies[0].positions.size(), 4u);
+  ASSERT_EQ(state.bodies[1].velocities.size(), 2u);
+  EXPECT_EQ(state.bodies[1].positions[0].y, 2.0);
+  EXPECT_EQ(state.bodies[1].velocities[0].x, 0.5);
+}
+
+TEST(RosConverter, NonFiniteNodesAreLeftOutOfTheMarkers)
+{
+  World world = twoBodies();
+  world.setNode(1, Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0), Vec3::Zero());
+  const visualization_msgs::MarkerArray array = RosConverter::toMarkers(world, "map", ros::Time(1.0));
+  EXPECT_EQ(array.markers[0].points.size(), 3u);  // rope nodes 0, 2, 3
+  EXPECT_EQ(array.markers[1].points.size(), 2u);  // only the spring 2-3 has two finite ends
+  for (const visualization_msgs::Marker& m : array.markers)
+    for (const geometry_msgs::Point& p : m.points)
+      EXPECT_TRUE(std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z));
+}
+
+TEST(RosConverter, PosesWithNaNOrInfinityAreRejected)
+{
+  geometry_msgs::Pose pose;
+  pose.position.x = 1.0;
+  pose.position.y = -2.0;
+  pose.position.z = 0.5;
+  pose.orientation.w = 1.0;
+  Vec3 position;
+  std::string why;
+  ASSERT_TRUE(RosConverter::fromPose(pose, position, why));
+  EXPECT_EQ(position, Vec3(1.0, -2.0, 0.5));
+
+  geometry_msgs::Pose bad = pose;
+  bad.position.y = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(RosConverter::fromPose(bad, position, why));
+  EXPECT_EQ(why, "position is not finite");
+  bad = pose;
+  bad.position.z = -std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(RosConverter::fromPose(bad, position, why));
+  bad = pose;
+  bad.orientation.x = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(RosConverter::fromPose(bad, position, why));
+  EXPECT_EQ(why, "orientation is not finite");
+  EXPECT_EQ(position, Vec3(1.0, -2.0, 0.5));  // untouched by the rejected poses
+}
+
+}  // namespace
+}  // namespace soft_body_sim::test
