@@ -34,7 +34,9 @@ TEST(ExampleScenes, EachRunsTenSecondsWithoutNaN)
     {
       world.step();
       if (n % 100 == 0 || n == steps)
+      {
         ASSERT_TRUE(world.state().position.allFinite() && world.state().velocity.allFinite()) << "step " << n;
+      }
     }
   }
 }
