@@ -23,6 +23,7 @@ void SimNode::initialize()
   rate_ = scene_.rate;
   if (private_nh_.getParam("rate", rate_) && !(rate_ > 0.0 && std::isfinite(rate_)))
     throw std::runtime_error(private_nh_.resolveName("rate") + ": must be a finite number > 0 [Hz]");
+  private_nh_.param("status_period", status_period_, 0.0);
   world_ = std::make_unique<World>(buildWorld(scene_));
   const double dt = world_->settings().dt;
   max_steps_per_tick_ = std::max(1L, std::lround(std::ceil(2.0 / (rate_ * dt))));
@@ -110,6 +111,16 @@ void SimNode::onTimer(const ros::TimerEvent&)
   if (!paused_)
     advance(elapsed);
   publish(now);
+  if (status_period_ > 0.0 && (now - last_status_).toSec() >= status_period_)
+    printStatus(now);
+}
+
+void SimNode::printStatus(const ros::Time& now)
+{
+  last_status_ = now;
+  ROS_INFO("soft_body_sim: t = %.1f s simulated%s, real-time factor %.2f, %.1f us per physics step",
+           world_->time(), paused_ ? " (paused)" : "", statistics_.real_time_factor,
+           1e6 * statistics_.wall_seconds_per_step);
 }
 
 void SimNode::advance(double elapsed)

@@ -34,6 +34,7 @@ private:
   /// Advances the accumulator by `elapsed` [s] of ROS time in fixed steps, at most max_steps_per_tick_.
   void advance(double elapsed);
   void publish(const ros::Time& now);
+  void printStatus(const ros::Time& now);
 
   /// The pose's position in the scene frame; false (with a throttled warning naming `topic` and the
   /// reason) if it is not finite or its frame cannot be transformed.
@@ -48,6 +49,7 @@ private:
   SceneDef scene_;
   std::unique_ptr<World> world_;
   double rate_ = 60.0;          ///< [Hz] of the timer
+  double status_period_ = 0.0;  ///< [s] between status lines on the console; 0 = none
   long max_steps_per_tick_ = 1;  ///< catch-up cap: two ticks' worth of steps
 
   tf2_ros::Buffer tf_buffer_;
@@ -60,6 +62,7 @@ private:
   ros::Timer timer_;
 
   ros::Time last_tick_;
+  ros::Time last_status_;
   double accumulator_ = 0.0;  ///< [s] of ROS time not yet simulated
   bool paused_ = false;
   StepStatistics statistics_;
