@@ -722,11 +722,11 @@ bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
       "explicit_euler, semi_implicit_euler, verlet, velocity_verlet, rk4, implicit_euler, xpbd" } },
   { "UnknownBodyType", R"(bodies:
   - name: b
-    type: rope
+    type: blob
     nodes:
       - {position: [0, 0, 0], mass: 1}
 )",
-    "bad.yaml:3: bodies[0].type", { "unknown body type 'rope'", "custom" } },
+    "bad.yaml:3: bodies[0].type", { "unknown body type 'blob'", "custom" } },
   { "DuplicateBodyName", R"(bodies:
   - name: twin
     type: custom

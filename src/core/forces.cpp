@@ -1,5 +1,9 @@
 #include "soft_body_sim/core/forces.h"
 
+#include <cmath>
+
+#include <Eigen/Geometry>
+
 namespace soft_body_sim
 {
 void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force)
@@ -17,11 +21,55 @@ void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeAr
   }
 }
 
+double cellArea(const PressureCell& cell, const NodeArray& x, Vec3* gradient)
+{
+  const Vec3 diagonal_02 = x.col(cell.nodes[2]) - x.col(cell.nodes[0]);
+  const Vec3 diagonal_13 = x.col(cell.nodes[3]) - x.col(cell.nodes[1]);
+  if (gradient)
+  {
+    gradient[0] = -0.5 * diagonal_13.cross(cell.normal);
+    gradient[1] = -0.5 * cell.normal.cross(diagonal_02);
+    gradient[2] = -gradient[0];
+    gradient[3] = -gradient[1];
+  }
+  return 0.5 * cell.normal.dot(diagonal_02.cross(diagonal_13));
+}
+
+CellGas cellGas(const PressureCell& cell, double area)
+{
+  if (!(cell.rest_area > 0.0) || !(cell.pressure > 0.0))
+    return { 0.0, 0.0, 0.0 };  // no gas (buildWorld never makes such a cell)
+  const double p0 = cell.pressure;
+  const double a = area / cell.rest_area;
+  if (a >= kCellBarrierArea)
+    return { p0 * cell.rest_area * (a - 1.0 - std::log(a)), p0 * (1.0 / a - 1.0), p0 / (cell.rest_area * a * a) };
+  // E(a) = E(a_c) + E'(a_c) (a - a_c) + 1/2 E''(a_c) (a - a_c)^2, in units of p0 A0.
+  const double a_c = kCellBarrierArea;
+  const double slope = 1.0 - 1.0 / a_c;     // dE/da at a_c, < 0
+  const double curvature = 1.0 / (a_c * a_c);  // d2E/da2 at a_c
+  const double da = a - a_c;
+  const double energy = (a_c - 1.0 - std::log(a_c)) + slope * da + 0.5 * curvature * da * da;
+  return { p0 * cell.rest_area * energy, -p0 * (slope + curvature * da), p0 * curvature / cell.rest_area };
+}
+
+void accumulatePressureForces(const Model& model, const NodeArray& x, NodeArray& force)
+{
+  Vec3 gradient[4];
+  for (const PressureCell& cell : model.cells)
+  {
+    const double pressure = cellGas(cell, cellArea(cell, x, gradient)).pressure;
+    for (int k = 0; k < 4; ++k)
+      force.col(cell.nodes[k]) += pressure * gradient[k];
+  }
+}
+
 void computeAccelerations(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force,
                           NodeArray& acceleration)
 {
   force.setZero(3, x.cols());
   accumulateSpringForces(model, x, v, force);
+  if (!model.cells.empty())
+    accumulatePressureForces(model, x, force);
   acceleration.resize(3, x.cols());
   for (int i = 0; i < model.nodeCount(); ++i)
   {
@@ -49,6 +97,8 @@ double potentialEnergy(const Model& model, const State& state)
     const double stretch = (state.position.col(s.a) - state.position.col(s.b)).norm() - s.rest_length;
     energy += 0.5 * s.stiffness * stretch * stretch;
   }
+  for (const PressureCell& cell : model.cells)
+    energy += cellGas(cell, cellArea(cell, state.position)).energy;
   for (int i = 0; i < model.nodeCount(); ++i)
     if (model.isFree(i))
       energy -= model.mass[i] * model.gravity.dot(state.position.col(i));

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "soft_body_sim/core/forces.h"
+
 namespace soft_body_sim
 {
 namespace
@@ -65,6 +67,21 @@ World buildWorld(const SceneDef& scene)
       const int a = globalIndex(body, first, c.a);
       const int b = globalIndex(body, first, c.b);
       model.constraints.push_back({ a, b, restLengthOr(c.rest_length, state, a, b), c.compliance });
+    }
+    for (const CellDef& c : body.cells)
+    {
+      PressureCell cell;
+      for (int k = 0; k < 4; ++k)
+        cell.nodes[k] = globalIndex(body, first, c.nodes[k]);
+      if (!(c.normal.norm() > 0.0))
+        throw std::invalid_argument("body '" + body.name + "': cell normal must not be zero");
+      cell.normal = c.normal.normalized();
+      cell.pressure = c.pressure;
+      cell.rest_area = c.rest_area ? *c.rest_area : cellArea(cell, state.position);
+      if (!(cell.rest_area > 0.0) || !(cell.pressure > 0.0))
+        throw std::invalid_argument("body '" + body.name + "': a cell needs a positive rest area (its nodes "
+                                    "counter-clockwise about its normal) and a positive pressure");
+      model.cells.push_back(cell);
     }
     for (const AnchorDef& anchor : body.anchors)
     {

@@ -8,6 +8,11 @@
 
 #include "yaml_reader.h"
 
+namespace soft_body_sim
+{
+struct LimbMotion;
+}
+
 namespace soft_body_sim::scene_yaml
 {
 using BodyReader = BodyDef (*)(const Context& ctx, const Field& body);
@@ -25,5 +30,18 @@ const std::vector<BodyType>& bodyTypes();
 Keys withCommonBodyKeys(const Keys& own);
 
 BodyDef readCustomBody(const Context& ctx, const Field& body);
+BodyDef readRopeBody(const Context& ctx, const Field& body);
+BodyDef readClothBody(const Context& ctx, const Field& body);
+BodyDef readJellyBody(const Context& ctx, const Field& body);
+
+// Procedurally animated body types (creature, limb, humanoid).
+BodyDef readCreatureBody(const Context& ctx, const Field& body);
+BodyDef readLimbBody(const Context& ctx, const Field& body);
+BodyDef readHumanoidBody(const Context& ctx, const Field& body);
+/// The limb-motion keys that `limb` and `humanoid` share (limb_reader.cpp): gravity, frame_period,
+/// max_frames_per_step, iterations, tension, retention, curve_samples.
+const Keys& limbMotionKeys();
+/// Reads the limbMotionKeys() present in `body` (a mapping checked by requireMap) into `motion`.
+void readLimbMotion(const Context& ctx, const Field& body, LimbMotion& motion);
 
 }  // namespace soft_body_sim::scene_yaml

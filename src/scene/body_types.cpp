@@ -6,6 +6,12 @@ const std::vector<BodyType>& bodyTypes()
 {
   static const std::vector<BodyType> types = {
     { "custom", readCustomBody },
+    { "rope", readRopeBody },
+    { "cloth", readClothBody },
+    { "jelly", readJellyBody },
+    { "creature", readCreatureBody },
+    { "limb", readLimbBody },
+    { "humanoid", readHumanoidBody },
   };
   return types;
 }

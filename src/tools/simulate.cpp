@@ -9,6 +9,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "soft_body_sim/core/stability.h"
 #include "soft_body_sim/scene/scene_loader.h"
 
 namespace soft_body_sim
@@ -148,11 +149,14 @@ void writeRows(std::ostream& csv, const World& world)
   }
 }
 
-void simulate(const Options& options, std::ostream& out)
+void simulate(const Options& options, std::ostream& out, std::ostream& err)
 {
   SceneDef scene = loadSceneFile(options.scene);
   applyOverrides(options, scene);
   World world = buildWorld(scene);
+  // Reported, not clamped: the run goes ahead with the scene as written.
+  for (const std::string& warning : stabilityWarnings(world.model(), world.state(), world.integrator(), world.settings()))
+    err << "simulate: warning: " << warning << '\n';
   const long long steps = std::llround(options.duration / scene.physics.step.dt);
 
   std::ofstream file;
@@ -181,7 +185,7 @@ int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::os
 {
   try
   {
-    simulate(parseOptions(args), out);
+    simulate(parseOptions(args), out, err);
     return 0;
   }
   catch (const std::exception& e)

@@ -24,14 +24,54 @@ inline bool springAxis(const NodeArray& x, int a, int b, Vec3& u, double& length
 /// Adds every spring's Hooke + dashpot force [N] to `force` (see Spring).
 void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force);
 
-/// a(x, v) [m/s^2] of the model: gravity + F/m - drag v on free nodes, 0 on pinned ones.
+/// Below this fraction a = A / A0 of its rest area a cell's gas law continues as a parabola (see CellGas).
+constexpr double kCellBarrierArea = 0.1;
+
+/// Signed area A [m^2] of a pressure cell (see PressureCell), the diagonal form of the shoelace formula:
+///   A = 1/2 n . ((x_2 - x_0) x (x_3 - x_1)),
+/// and, if `gradient` is given, dA/dx_k [m] for its four corners:
+///   dA/dx_0 = -1/2 (x_3 - x_1) x n = -dA/dx_2,   dA/dx_1 = -1/2 n x (x_2 - x_0) = -dA/dx_3.
+/// Each lies in the cell's plane, normal to the diagonal opposite its node. They sum to zero and A is
+/// unchanged by rotations about n, so the pressure force below exerts no net force or torque.
+double cellArea(const PressureCell& cell, const NodeArray& x, Vec3* gradient = nullptr);
+
+/// The gas of a jelly cell at signed area A, with a = A / A0 (Boyle's law in an atmosphere of the
+/// rest pressure p0, so that the cell is at rest at A0):
+///   a >= a_c:  E = p0 A0 (a - 1 - ln a),   p = -dE/dA = p0 (1/a - 1),   dp/dA = -p0 / (A0 a^2)
+///   a <  a_c:  the second-order Taylor continuation of E about a_c = kCellBarrierArea (C2 joint),
+///              p = p0 (1/a_c - 1 + (a_c - a) / a_c^2),  dp/dA = -p0 / (A0 a_c^2)
+/// and the force on corner k is F_k = p dA/dx_k.
+/// Why this and not the seed's: the jelly seed pushes each node out from the cell's centroid in
+/// proportion to the change of that distance. That force has no energy of the cell's shape, and once
+/// nodes cross it points wherever the centroid-to-node line happens to point ("drives the structure
+/// in improbable directions"). Here the force is minus the gradient of an energy of the signed area:
+/// it only ever moves nodes so as to restore the area, it is consistent with potentialEnergy(), and
+/// it grows without bound as the cell is squeezed (the log barrier: 9 p0 at a = 0.1), so a cell
+/// cannot be flattened by any bounded energy. Should a large step still push a cell past its barrier,
+/// the continuation keeps p > 0 and growing for a <= 0: an inverted cell is pushed back inside out
+/// instead of being blown further apart. For small changes p ~ -p0 (A - A0) / A0: p0 is the cell's
+/// 2D bulk modulus.
+struct CellGas
+{
+  double energy;     ///< E [J]
+  double pressure;   ///< p = -dE/dA [N/m]; > 0 pushes the outline outward
+  double stiffness;  ///< d^2E/dA^2 = -dp/dA [N/m^3], > 0
+};
+CellGas cellGas(const PressureCell& cell, double area);
+
+/// Adds every cell's pressure force F_k = p dA/dx_k [N] to `force` (nothing without cells).
+void accumulatePressureForces(const Model& model, const NodeArray& x, NodeArray& force);
+
+/// a(x, v) [m/s^2] of the model: gravity + F/m - drag v on free nodes, 0 on pinned ones; F is the
+/// springs' force plus, when the model has cells, their pressure.
 /// `force` is caller-owned scratch space so that the hot loop never allocates.
 void computeAccelerations(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force,
                           NodeArray& acceleration);
 
 /// Kinetic [J] of the free nodes.
 double kineticEnergy(const Model& model, const State& state);
-/// Potential [J]: elastic energy of the springs plus gravitational energy -m g.x of the free nodes.
+/// Potential [J]: elastic energy of the springs and the cells' gas plus gravitational energy -m g.x
+/// of the free nodes.
 double potentialEnergy(const Model& model, const State& state);
 
 }  // namespace soft_body_sim

@@ -35,6 +35,19 @@ struct DistanceConstraint
   double compliance = 0.0;   ///< alpha [m/N], >= 0
 };
 
+/// A gas-filled quadrilateral cell of a 2D body (jelly): four nodes, counter-clockwise about `normal`.
+/// Its signed area A is that of the outline projected on the plane normal to `normal`, so it is
+/// positive at rest and changes sign when the cell turns inside out. The gas follows Boyle's law in an
+/// atmosphere of the same rest pressure: net pressure p(A) = pressure (rest_area / A - 1), force
+/// F_k = p dA/dx_k, energy pressure rest_area (a - 1 - ln a) with a = A / rest_area (see forces.h).
+struct PressureCell
+{
+  int nodes[4] = { 0, 0, 0, 0 };
+  Vec3 normal = Vec3::UnitZ();  ///< unit normal of the cell's plane
+  double rest_area = 0.0;       ///< A0 [m^2], > 0
+  double pressure = 0.0;        ///< p0 [N/m] (2D pressure: force per length of outline), > 0
+};
+
 /// A named run of consecutive nodes: the scene's bodies share one node array.
 struct BodyRange
 {
@@ -69,6 +82,7 @@ struct Model
   Eigen::VectorXd inverse_mass;  ///< [1/kg] per node, 0 for pinned nodes
   std::vector<Spring> springs;
   std::vector<DistanceConstraint> constraints;
+  std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then
   std::vector<BodyRange> bodies;
   std::vector<Plane> planes;
   std::vector<Anchor> anchors;

@@ -38,6 +38,16 @@ struct ConstraintDef
   std::optional<double> rest_length;     ///< [m]; default: the initial distance
 };
 
+/// A gas-filled quadrilateral cell (see PressureCell): four node indices within the body,
+/// counter-clockwise about `normal`.
+struct CellDef
+{
+  int nodes[4] = { 0, 0, 0, 0 };
+  Vec3 normal = Vec3::UnitZ();         ///< normal of the cell's plane (need not be unit)
+  double pressure = 0.0;               ///< rest pressure p0 [N/m], > 0
+  std::optional<double> rest_area;     ///< [m^2], > 0; default: the initial signed area
+};
+
 /// A named node that the caller moves (World::moveAnchor); the node is pinned.
 struct AnchorDef
 {
@@ -54,6 +64,7 @@ struct BodyDef
   std::vector<NodeDef> nodes;
   std::vector<SpringDef> springs;
   std::vector<ConstraintDef> constraints;
+  std::vector<CellDef> cells;  ///< pressure cells (jelly); usually empty
   std::vector<AnchorDef> anchors;
   ControllerFactory controller;  ///< empty for passive bodies
 };
@@ -77,7 +88,8 @@ struct SceneDef
 
 /// Flattens the bodies into one node array (body k's nodes follow body k-1's), pins anchored nodes,
 /// makes the controllers and returns the world. Expects a valid scene (the loader checks); throws
-/// std::invalid_argument on an index out of range or a zero plane normal.
+/// std::invalid_argument on an index out of range, a zero plane or cell normal, or a cell whose rest
+/// area is not positive.
 World buildWorld(const SceneDef& scene);
 
 }  // namespace soft_body_sim

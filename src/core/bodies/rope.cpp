@@ -19,6 +19,8 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
       rope.bending < 0.0 || rope.bending_damping < 0.0)
     throw std::invalid_argument("rope '" + name + "': needs >= 2 nodes, mass > 0, stiffness > 0, no negative "
                                 "damping or bending");
+  if (!((rope.to - rope.from).norm() > 0.0))
+    throw std::invalid_argument("rope '" + name + "': from and to must differ");
   BodyDef body;
   body.name = name;
   body.type = "rope";

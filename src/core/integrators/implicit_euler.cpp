@@ -19,6 +19,10 @@ using Matrix3 = Eigen::Matrix3d;
 /// K's transverse term k (1 - L/l)(I - u u^T) is dropped when the spring is compressed (Choi & Ko
 /// 2002) so that the matrix stays symmetric positive definite; the damping force's dependence on x is
 /// neglected, as in Baraff & Witkin. Unconditionally stable on a linear spring; first order.
+/// Pressure cells (jelly) enter f with F_k = p dA/dx_k and K with its Gauss-Newton part
+///   K_kl = -(d^2E/dA^2) dA/dx_k dA/dx_l^T,
+/// dropping p d^2A/dx_k dx_l, which is indefinite (A is bilinear in the positions) and vanishes at
+/// rest; the kept part is the one that stiffens without bound as the cell is squeezed.
 class ImplicitEuler final : public Integrator
 {
 public:
@@ -66,6 +70,8 @@ private:
     const int n = model.nodeCount();
     force_.setZero(3, n);
     accumulateSpringForces(model, x, v, force_);
+    if (!model.cells.empty())
+      accumulatePressureForces(model, x, force_);
     triplets_.clear();
     rhs_.resize(3 * n);
     for (int i = 0; i < n; ++i)
@@ -112,8 +118,31 @@ private:
         addBlock(s.b, s.a, -block);
       }
     }
+    for (const PressureCell& cell : model.cells)
+      addCell(model, cell, x, h);
     matrix_.resize(3 * n, 3 * n);
     matrix_.setFromTriplets(triplets_.begin(), triplets_.end());
+  }
+
+  /// The cell's share of matrix_ (h^2 S g_k g_l^T, S = d^2E/dA^2, g_k = dA/dx_k) and of rhs_
+  /// (h K offset, with (K offset)_k = -S g_k sum_l g_l . offset_l) on its free corners.
+  void addCell(const Model& model, const PressureCell& cell, const NodeArray& x, double h)
+  {
+    Vec3 g[4];
+    const double stiffness = cellGas(cell, cellArea(cell, x, g)).stiffness;
+    double g_dot_offset = 0.0;
+    for (int k = 0; k < 4; ++k)
+      g_dot_offset += g[k].dot(offset_.col(cell.nodes[k]));
+    for (int k = 0; k < 4; ++k)
+    {
+      const int row = cell.nodes[k];
+      if (!model.isFree(row))
+        continue;
+      rhs_.segment<3>(3 * row) -= (h * stiffness * g_dot_offset) * g[k];
+      for (int l = 0; l < 4; ++l)
+        if (model.isFree(cell.nodes[l]))
+          addBlock(row, cell.nodes[l], (h * h * stiffness) * g[k] * g[l].transpose());
+    }
   }
 
   void addBlock(int row, int col, const Matrix3& block)

@@ -1,0 +1,64 @@
+// Cloth (tum-mass-spring-tutorial.txt: "model it as a grid of mass points" joined by springs): a grid
+// of equal-mass nodes with structural springs to the four direct neighbours, shear springs across each
+// square's diagonals and, if asked, bending springs to the second neighbours along rows and columns.
+// Also the grid layout the jelly shares: three named corners and row-by-row node numbering.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "soft_body_sim/core/scene_def.h"
+
+namespace soft_body_sim
+{
+/// Stiffness and dashpot of one family of springs of a generated body.
+struct SpringParameters
+{
+  double stiffness = 0.0;  ///< k [N/m]
+  double damping = 0.0;    ///< c [N s/m]
+};
+
+/// A parallelogram in space given by three corners [m]; the fourth, bottom_right, is
+/// top_right + bottom_left - top_left. A grid of `columns` x `rows` nodes spans it: node (i, j), column
+/// i = 0..columns-1 from the left edge and row j = 0..rows-1 from the top edge, has index j * columns + i
+/// and sits at top_left + i / (columns - 1) (top_right - top_left) + j / (rows - 1) (bottom_left - top_left).
+/// "Top" is only a name: a grid can lie in any orientation.
+struct GridCorners
+{
+  Vec3 top_left = Vec3(0.0, 0.0, 1.0);
+  Vec3 top_right = Vec3(1.0, 0.0, 1.0);
+  Vec3 bottom_left = Vec3(0.0, 0.0, 0.0);
+
+  /// The point at fractions s along the top edge and t along the left edge.
+  Vec3 at(double s, double t) const { return top_left + s * (top_right - top_left) + t * (bottom_left - top_left); }
+  /// (top_right - top_left) x (bottom_left - top_left): the grid's normal times its area [m^2].
+  Vec3 areaNormal() const { return (top_right - top_left).cross(bottom_left - top_left); }
+  /// False when the corners are (nearly) collinear or coincide and span no parallelogram.
+  bool spansParallelogram() const;
+};
+
+/// The names of a grid's corners: top_left, top_right, bottom_left, bottom_right.
+const std::vector<std::string>& gridCornerNames();
+/// The index of the named corner node of a grid of columns x rows nodes; nullopt for an unknown name.
+std::optional<int> gridCornerNode(const std::string& name, int columns, int rows);
+
+struct ClothDef
+{
+  int nx = 10;                                           ///< nodes per row (along the top edge), >= 2
+  int ny = 10;                                           ///< nodes per column (along the left edge), >= 2
+  GridCorners corners;                                   ///< where the cloth starts, flat and at rest [m]
+  double mass = 0.2;                                     ///< total mass [kg], spread equally over the nodes
+  SpringParameters structural{ 200.0, 0.05 };            ///< springs to the 4 direct neighbours
+  SpringParameters shear{ 50.0, 0.05 };                  ///< springs across each square's 2 diagonals
+  SpringParameters bending{ 0.0, 0.0 };                  ///< springs to second neighbours; stiffness 0 = none
+  std::vector<int> pinned;                               ///< pinned node indices; negative counts from the end
+};
+
+/// The cloth as nodes and springs (type "cloth"), every spring at rest in the flat initial layout;
+/// throws std::invalid_argument on a bad definition and std::out_of_range on a bad pinned index.
+BodyDef buildCloth(const std::string& name, const ClothDef& cloth);
+
+}  // namespace soft_body_sim

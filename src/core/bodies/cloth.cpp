@@ -1,0 +1,90 @@
+#include "soft_body_sim/core/bodies/cloth.h"
+
+#include <stdexcept>
+
+#include "soft_body_sim/core/bodies/rope.h"
+
+namespace soft_body_sim
+{
+bool GridCorners::spansParallelogram() const
+{
+  // The sine of the angle between the edges: below 1e-9 the grid is a line (or a point).
+  const Vec3 top = top_right - top_left;
+  const Vec3 left = bottom_left - top_left;
+  const double scale = top.norm() * left.norm();
+  return scale > 0.0 && areaNormal().norm() > 1e-9 * scale;
+}
+
+const std::vector<std::string>& gridCornerNames()
+{
+  static const std::vector<std::string> names = { "top_left", "top_right", "bottom_left", "bottom_right" };
+  return names;
+}
+
+std::optional<int> gridCornerNode(const std::string& name, int columns, int rows)
+{
+  if (name == "top_left")
+    return 0;
+  if (name == "top_right")
+    return columns - 1;
+  if (name == "bottom_left")
+    return (rows - 1) * columns;
+  if (name == "bottom_right")
+    return rows * columns - 1;
+  return std::nullopt;
+}
+
+BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
+{
+  if (cloth.nx < 2 || cloth.ny < 2 || !(cloth.mass > 0.0) || !(cloth.structural.stiffness > 0.0) ||
+      !(cloth.shear.stiffness > 0.0) || cloth.bending.stiffness < 0.0 || cloth.structural.damping < 0.0 ||
+      cloth.shear.damping < 0.0 || cloth.bending.damping < 0.0)
+    throw std::invalid_argument("cloth '" + name + "': needs nx, ny >= 2, mass > 0, structural and shear "
+                                "stiffness > 0, no negative bending stiffness or damping");
+  if (!cloth.corners.spansParallelogram())
+    throw std::invalid_argument("cloth '" + name + "': the corners span no parallelogram");
+  BodyDef body;
+  body.name = name;
+  body.type = "cloth";
+  const int nx = cloth.nx;
+  const int ny = cloth.ny;
+  const double node_mass = cloth.mass / (nx * ny);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      body.nodes.push_back(NodeDef{ cloth.corners.at(static_cast<double>(i) / (nx - 1), static_cast<double>(j) / (ny - 1)),
+                                    node_mass, Vec3::Zero(), false });
+  for (int index : cloth.pinned)
+    body.nodes[static_cast<std::size_t>(resolveNodeIndex(index, nx * ny))].pinned = true;
+
+  // Rest lengths stay empty: the flat initial layout is the rest shape.
+  const auto node = [nx](int i, int j) { return j * nx + i; };
+  const auto link = [&body](int a, int b, const SpringParameters& p) {
+    body.springs.push_back(SpringDef{ a, b, p.stiffness, p.damping, std::nullopt });
+  };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+    {
+      if (i + 1 < nx)
+        link(node(i, j), node(i + 1, j), cloth.structural);
+      if (j + 1 < ny)
+        link(node(i, j), node(i, j + 1), cloth.structural);
+    }
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i)
+    {
+      link(node(i, j), node(i + 1, j + 1), cloth.shear);
+      link(node(i + 1, j), node(i, j + 1), cloth.shear);
+    }
+  if (cloth.bending.stiffness > 0.0)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i)
+      {
+        if (i + 2 < nx)
+          link(node(i, j), node(i + 2, j), cloth.bending);
+        if (j + 2 < ny)
+          link(node(i, j), node(i, j + 2), cloth.bending);
+      }
+  return body;
+}
+
+}  // namespace soft_body_sim

@@ -1,0 +1,27 @@
+// `type: cloth` (tum-mass-spring-tutorial.txt): a grid of nx x ny nodes spanning three corners.
+#include "generated_body_keys.h"
+
+namespace soft_body_sim::scene_yaml
+{
+BodyDef readClothBody(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass",
+                                              "structural", "shear", "bending", "pinned" }));
+  ClothDef cloth;
+  cloth.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 2);
+  const Field ny = requiredKey(ctx, field, "ny");
+  cloth.ny = readCount(ctx, ny, 2);
+  checkGridSize(ctx, ny, cloth.nx, cloth.ny);
+  cloth.corners = readGridCorners(ctx, field);
+  cloth.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
+  cloth.structural = readSpringParameters(ctx, requiredKey(ctx, field, "structural"));
+  cloth.shear = readSpringParameters(ctx, requiredKey(ctx, field, "shear"));
+  cloth.bending = SpringParameters{ 0.0, 0.0 };
+  if (const std::optional<Field> value = optionalKey(field, "bending"))
+    cloth.bending = readSpringParameters(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "pinned"))
+    cloth.pinned = readPinned(ctx, *value, cloth.nx * cloth.ny, cloth.nx, cloth.ny);
+  return buildCloth("cloth", cloth);
+}
+
+}  // namespace soft_body_sim::scene_yaml

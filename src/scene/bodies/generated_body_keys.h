@@ -1,0 +1,92 @@
+// Keys shared by the readers of the generated mass-spring bodies (rope, cloth, jelly): node counts,
+// spring families, grid corners and pinned nodes. Private to those readers.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "../body_readers.h"
+#include "soft_body_sim/core/bodies/cloth.h"
+
+namespace soft_body_sim::scene_yaml
+{
+/// The most nodes a generated body may have: a typo such as `nx: 100000` fails here with a message
+/// rather than exhausting memory.
+constexpr long long kMaxGeneratedNodes = 1000000;
+
+/// An integer count in [minimum, kMaxGeneratedNodes].
+inline int readCount(const Context& ctx, const Field& field, long long minimum)
+{
+  const long long value = readInteger(ctx, field);
+  if (value < minimum || value > kMaxGeneratedNodes)
+    ctx.fail(field, "must be an integer in [" + std::to_string(minimum) + ", " + std::to_string(kMaxGeneratedNodes) +
+                        "], got " + field.node.Scalar());
+  return static_cast<int>(value);
+}
+
+/// Fails at `field` if a grid of columns x rows nodes is larger than kMaxGeneratedNodes.
+inline void checkGridSize(const Context& ctx, const Field& field, long long columns, long long rows)
+{
+  if (columns * rows > kMaxGeneratedNodes)
+    ctx.fail(field, "the grid would have " + std::to_string(columns) + " x " + std::to_string(rows) +
+                        " nodes, more than " + std::to_string(kMaxGeneratedNodes));
+}
+
+/// `{stiffness: k, damping: c}`: k [N/m] > 0 required, c [N s/m] >= 0 (default 0).
+inline SpringParameters readSpringParameters(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, { "stiffness", "damping" });
+  SpringParameters spring;
+  spring.stiffness = readPositive(ctx, requiredKey(ctx, field, "stiffness"));
+  if (const std::optional<Field> value = optionalKey(field, "damping"))
+    spring.damping = readNonNegative(ctx, *value);
+  return spring;
+}
+
+/// The required keys top_left, top_right and bottom_left [m] of a grid body.
+inline GridCorners readGridCorners(const Context& ctx, const Field& body)
+{
+  GridCorners corners;
+  corners.top_left = readVec3(ctx, requiredKey(ctx, body, "top_left"));
+  corners.top_right = readVec3(ctx, requiredKey(ctx, body, "top_right"));
+  const Field bottom_left = requiredKey(ctx, body, "bottom_left");
+  corners.bottom_left = readVec3(ctx, bottom_left);
+  if (!corners.spansParallelogram())
+    ctx.fail(bottom_left, "top_left, top_right and bottom_left must span a parallelogram; they are collinear "
+                          "or coincide");
+  return corners;
+}
+
+/// `pinned: [...]`: node indices of a body of `node_count` nodes, a negative one counting from the end
+/// (-1 is the last node); for a grid of columns x rows nodes (rows > 0) also the corner names of
+/// gridCornerNames(). Returns non-negative indices.
+inline std::vector<int> readPinned(const Context& ctx, const Field& field, int node_count, int columns = 0,
+                                   int rows = 0)
+{
+  std::vector<int> pinned;
+  const long long n = node_count;
+  for (const Field& item : requireList(ctx, field))
+  {
+    const bool named = rows > 0 && item.node.IsScalar() && !item.node.Scalar().empty() &&
+                       std::string("+-0123456789").find(item.node.Scalar()[0]) == std::string::npos;
+    if (named)
+    {
+      const std::optional<int> corner = gridCornerNode(item.node.Scalar(), columns, rows);
+      if (!corner)
+        ctx.fail(item, "unknown corner " + quoted(item.node.Scalar()) + "; expected a node index or one of " +
+                           join(gridCornerNames()));
+      pinned.push_back(*corner);
+      continue;
+    }
+    if (rows > 0 && !item.node.IsScalar())
+      ctx.fail(item, "expected a node index or a corner name, got " + describe(item.node));
+    const long long index = readInteger(ctx, item);
+    if (index < -n || index >= n)
+      ctx.fail(item, "node index " + std::to_string(index) + " out of range; the body has " + std::to_string(n) +
+                         " nodes (" + std::to_string(-n) + ".." + std::to_string(n - 1) + ")");
+    pinned.push_back(static_cast<int>(index < 0 ? index + n : index));
+  }
+  return pinned;
+}
+
+}  // namespace soft_body_sim::scene_yaml

@@ -1,0 +1,24 @@
+// `type: jelly` (springy-viscous-jelly.txt): nx x ny gas-filled cells spanning three corners.
+#include "generated_body_keys.h"
+#include "soft_body_sim/core/bodies/jelly.h"
+
+namespace soft_body_sim::scene_yaml
+{
+BodyDef readJellyBody(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass", "edges",
+                                              "diagonals", "pressure" }));
+  JellyDef jelly;
+  jelly.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 1);
+  const Field ny = requiredKey(ctx, field, "ny");
+  jelly.ny = readCount(ctx, ny, 1);
+  checkGridSize(ctx, ny, jelly.nx + 1LL, jelly.ny + 1LL);
+  jelly.corners = readGridCorners(ctx, field);
+  jelly.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
+  jelly.edges = readSpringParameters(ctx, requiredKey(ctx, field, "edges"));
+  jelly.diagonals = readSpringParameters(ctx, requiredKey(ctx, field, "diagonals"));
+  jelly.pressure = readPositive(ctx, requiredKey(ctx, field, "pressure"));
+  return buildJelly("jelly", jelly);
+}
+
+}  // namespace soft_body_sim::scene_yaml
