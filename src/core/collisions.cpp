@@ -2,15 +2,18 @@
 
 namespace soft_body_sim
 {
-bool collideWithPlanes(const Model& model, State& state, double resting_speed)
+bool collideWithPlanes(const Model& model, State& state, double resting_speed, std::vector<std::uint8_t>& touching)
 {
-  bool touched = false;
-  for (const Plane& plane : model.planes)
+  touching.resize(static_cast<std::size_t>(model.nodeCount()), 0);
+  bool touched_any = false;
+  for (int i = 0; i < model.nodeCount(); ++i)
   {
-    for (int i = 0; i < model.nodeCount(); ++i)
+    if (!model.isFree(i))
+      continue;
+    const bool was_touching = touching[static_cast<std::size_t>(i)] != 0;
+    bool touched = false;
+    for (const Plane& plane : model.planes)
     {
-      if (!model.isFree(i))
-        continue;
       const double depth = (state.position.col(i) - plane.point).dot(plane.normal);
       if (depth >= 0.0)
         continue;
@@ -20,7 +23,8 @@ bool collideWithPlanes(const Model& model, State& state, double resting_speed)
       const double normal_speed = v.dot(plane.normal);
       if (normal_speed >= 0.0)
         continue;
-      const double bounce_speed = -normal_speed > resting_speed ? -plane.restitution * normal_speed : 0.0;
+      const bool impact = !was_touching && -normal_speed > resting_speed;
+      const double bounce_speed = impact ? -plane.restitution * normal_speed : 0.0;
       Vec3 tangential = v - normal_speed * plane.normal;
       const double tangential_speed = tangential.norm();
       const double friction_loss = plane.friction * (bounce_speed - normal_speed);
@@ -28,8 +32,10 @@ bool collideWithPlanes(const Model& model, State& state, double resting_speed)
         tangential *= std::max(0.0, 1.0 - friction_loss / tangential_speed);
       state.velocity.col(i) = tangential + bounce_speed * plane.normal;
     }
+    touching[static_cast<std::size_t>(i)] = touched ? 1 : 0;
+    touched_any = touched_any || touched;
   }
-  return touched;
+  return touched_any;
 }
 
 }  // namespace soft_body_sim

@@ -43,7 +43,7 @@ void World::step()
       integrator_->invalidate();
     }
     integrator_->step(model_, state_, h, settings_.iterations);
-    if (!model_.planes.empty() && collideWithPlanes(model_, state_, resting_speed))
+    if (!model_.planes.empty() && collideWithPlanes(model_, state_, resting_speed, touching_))
       integrator_->invalidate();
   }
   // Land exactly on the anchor goals (the sub-step sums differ from them by round-off).

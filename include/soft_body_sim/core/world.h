@@ -67,6 +67,7 @@ private:
   std::unique_ptr<Integrator> integrator_;
   std::vector<BodyController> controllers_;
   std::vector<std::optional<Vec3>> anchor_goals_;  ///< per anchor: where to be at the end of the next step
+  std::vector<std::uint8_t> touching_;              ///< per node: on a plane after the last sub-step
   std::int64_t steps_ = 0;
 };
 

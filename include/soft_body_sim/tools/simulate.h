@@ -12,8 +12,9 @@ namespace soft_body_sim
 ///                 [--iterations N] [--every K] [--csv FILE]
 /// Runs round(duration / dt) steps from t = 0 and writes `t,body,node,x,y,z` rows (17 significant
 /// digits) at t = 0, every K steps when --every is given, and after the last step; to `out` unless
-/// --csv names a file. Command-line values override the scene file's. On bad input writes one line to
-/// `err` and returns non-zero; returns 0 on success.
+/// --csv names a file. Command-line values override the scene file's. Before running, writes one
+/// line "simulate: warning: ..." to `err` for each stability limit an explicit integrator may exceed
+/// (see stability.h). On bad input writes one line to `err` and returns non-zero; returns 0 on success.
 int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace soft_body_sim
