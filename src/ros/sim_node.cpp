@@ -144,7 +144,15 @@ void SimNode::advance(double elapsed)
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (steps > 0)
     statistics_.wall_seconds_per_step = wall / static_cast<double>(steps);
-  statistics_.real_time_factor = elapsed > 0.0 ? steps * dt / elapsed : 0.0;
+  // Whole steps per tick alternate (e.g. 3 and 4 steps of 5 ms in 16.7 ms ticks): the real-time factor
+  // is taken over windows of at least half a second.
+  window_elapsed_ += elapsed;
+  window_simulated_ += steps * dt;
+  if (window_elapsed_ >= 0.5)
+  {
+    statistics_.real_time_factor = window_simulated_ / window_elapsed_;
+    window_elapsed_ = window_simulated_ = 0.0;
+  }
 }
 
 void SimNode::publish(const ros::Time& now)

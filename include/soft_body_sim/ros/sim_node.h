@@ -64,6 +64,8 @@ private:
   ros::Time last_tick_;
   ros::Time last_status_;
   double accumulator_ = 0.0;  ///< [s] of ROS time not yet simulated
+  double window_elapsed_ = 0.0;    ///< [s] of ROS time in the current real-time-factor window
+  double window_simulated_ = 0.0;  ///< [s] simulated in it
   bool paused_ = false;
   StepStatistics statistics_;
 };
