@@ -81,6 +81,16 @@ TEST(RosConverter, StateCarriesPositionsVelocitiesAndStatistics)
   EXPECT_EQ(state.bodies[1].velocities[0].x, 0.5);
 }
 
+TEST(RosConverter, AMarkerWithoutPointsIsSentAsDelete)
+{
+  SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);
+  scene.bodies[0].nodes = { NodeDef{ Vec3::Zero(), 1.0 } };  // no springs: an empty LINE_LIST
+  const visualization_msgs::MarkerArray array = RosConverter::toMarkers(buildWorld(scene), "map", ros::Time(1.0));
+  ASSERT_EQ(array.markers.size(), 2u);
+  EXPECT_EQ(array.markers[0].action, visualization_msgs::Marker::ADD);
+  EXPECT_EQ(array.markers[1].action, visualization_msgs::Marker::DELETE);
+}
+
 TEST(RosConverter, NonFiniteNodesAreLeftOutOfTheMarkers)
 {
   World world = twoBodies();

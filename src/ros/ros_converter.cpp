@@ -88,6 +88,12 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
   for (const DistanceConstraint& c : model.constraints)
     addSegment(x, c.a, c.b, array.markers[2 * static_cast<std::size_t>(body_of_node[c.a]) + 1]);
 
+  // rviz rejects list markers without points; an empty one is sent as DELETE, which also clears a
+  // marker that once had points.
+  for (visualization_msgs::Marker& m : array.markers)
+    if (m.points.empty())
+      m.action = visualization_msgs::Marker::DELETE;
+
   for (const BodyController& controlled : world.controllers())
   {
     const BodyRange& body = model.bodies[static_cast<std::size_t>(controlled.body)];
