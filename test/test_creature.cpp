@@ -11,6 +11,7 @@
 #include "soft_body_sim/core/bodies/creature.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "test_util.h"
+#include "scene_error.h"
 
 namespace soft_body_sim::test
 {
@@ -493,54 +494,38 @@ std::string creatureWith(const std::string& line)
   return "bodies:\n  - name: c\n    type: creature\n    " + line + "\n";
 }
 
-void expectError(const std::string& yaml, const std::string& location, const std::vector<std::string>& words)
-{
-  try
-  {
-    parseScene(yaml, "bad.yaml");
-    ADD_FAILURE() << "accepted:\n" << yaml;
-  }
-  catch (const SceneError& e)
-  {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    EXPECT_EQ(message.rfind(location + ": ", 0), 0u) << message << "\nexpected start: " << location;
-    for (const std::string& word : words)
-      EXPECT_NE(message.find(word), std::string::npos) << message << "\nmissing: " << word;
-  }
-}
 
 TEST(CreatureScene, BadValuesAreRejectedWithOneLineAtTheKey)
 {
   const std::string at = "bad.yaml:4: bodies[0].";
-  expectError(creatureWith("colour: red"), at + "colour", { "unknown key", "plane_normal", "tendrils" });
-  expectError(creatureWith("position: [1, 2]"), at + "position", { "3 numbers" });
-  expectError(creatureWith("heading: [0, 0, 0]"), at + "heading", { "zero" });
-  expectError(creatureWith("heading: [0, 0, 2]"), at + "heading", { "parallel to plane_normal" });
-  expectError(creatureWith("plane_normal: [0, 0, 0]"), at + "plane_normal", { "zero" });
-  expectError(creatureWith("length: '0.2'"), at + "length", { "expected a number" });
-  expectError(creatureWith("width: 0"), at + "width", { "> 0" });
-  expectError(creatureWith("update_period: -0.1"), at + "update_period", { "> 0" });
-  expectError(creatureWith("stiffness: -1"), at + "stiffness", { ">= 0" });
+  expectSceneError(creatureWith("colour: red"), at + "colour", { "unknown key", "plane_normal", "tendrils" });
+  expectSceneError(creatureWith("position: [1, 2]"), at + "position", { "3 numbers" });
+  expectSceneError(creatureWith("heading: [0, 0, 0]"), at + "heading", { "zero" });
+  expectSceneError(creatureWith("heading: [0, 0, 2]"), at + "heading", { "parallel to plane_normal" });
+  expectSceneError(creatureWith("plane_normal: [0, 0, 0]"), at + "plane_normal", { "zero" });
+  expectSceneError(creatureWith("length: '0.2'"), at + "length", { "expected a number" });
+  expectSceneError(creatureWith("width: 0"), at + "width", { "> 0" });
+  expectSceneError(creatureWith("update_period: -0.1"), at + "update_period", { "> 0" });
+  expectSceneError(creatureWith("stiffness: -1"), at + "stiffness", { ">= 0" });
   // k T^2 = 5000 / 900 = 5.6 > 2 (1 + 0.7) = 3.4
-  expectError(creatureWith("stiffness: 5000"), at + "stiffness", { "stable" });
-  expectError(creatureWith("lead_retention: 1.5"), at + "lead_retention", { "[0, 1]" });
-  expectError(creatureWith("anticipation: -0.2"), at + "anticipation", { ">= 0" });
-  expectError(creatureWith("parallel_retention: -0.1"), at + "parallel_retention", { ">= 0" });
-  expectError(creatureWith("perpendicular_retention: 2"), at + "perpendicular_retention", { "[0, 1]" });
-  expectError(creatureWith("side_retention: 1.01"), at + "side_retention", { "[0, 1]" });
-  expectError(creatureWith("min_ratio: 0"), at + "min_ratio", { "> 0" });
-  expectError(creatureWith("min_ratio: 1.2"), at + "min_ratio", { "(0, 1]" });
-  expectError(creatureWith("max_ratio: 0.9"), at + "max_ratio", { ">= 1" });
-  expectError(creatureWith("soft_strength: 0"), at + "soft_strength", { "> 0" });
-  expectError(creatureWith("hard_strength: 1.5"), at + "hard_strength", { "(0, 1]" });
-  expectError(creatureWith("iterations: 0"), at + "iterations", { "[1," });
-  expectError(creatureWith("tendrils: {segments: 0}"), at + "tendrils.segments", { "[1," });
-  expectError(creatureWith("tendrils: {legs: 3}"), at + "tendrils.legs", { "unknown key", "segments" });
-  expectError(creatureWith("tendrils: {mass: 0}"), at + "tendrils.mass", { "> 0" });
-  expectError(creatureWith("tendrils: {damping: -1}"), at + "tendrils.damping", { ">= 0" });
-  expectError(creatureWith("tendrils: {direction: [0, 0, 0]}"), at + "tendrils.direction", { "zero" });
-  expectError(creatureWith("tendrils: [1, 2]"), at + "tendrils", { "mapping" });
+  expectSceneError(creatureWith("stiffness: 5000"), at + "stiffness", { "stable" });
+  expectSceneError(creatureWith("lead_retention: 1.5"), at + "lead_retention", { "[0, 1]" });
+  expectSceneError(creatureWith("anticipation: -0.2"), at + "anticipation", { ">= 0" });
+  expectSceneError(creatureWith("parallel_retention: -0.1"), at + "parallel_retention", { ">= 0" });
+  expectSceneError(creatureWith("perpendicular_retention: 2"), at + "perpendicular_retention", { "[0, 1]" });
+  expectSceneError(creatureWith("side_retention: 1.01"), at + "side_retention", { "[0, 1]" });
+  expectSceneError(creatureWith("min_ratio: 0"), at + "min_ratio", { "> 0" });
+  expectSceneError(creatureWith("min_ratio: 1.2"), at + "min_ratio", { "(0, 1]" });
+  expectSceneError(creatureWith("max_ratio: 0.9"), at + "max_ratio", { ">= 1" });
+  expectSceneError(creatureWith("soft_strength: 0"), at + "soft_strength", { "> 0" });
+  expectSceneError(creatureWith("hard_strength: 1.5"), at + "hard_strength", { "(0, 1]" });
+  expectSceneError(creatureWith("iterations: 0"), at + "iterations", { "[1," });
+  expectSceneError(creatureWith("tendrils: {segments: 0}"), at + "tendrils.segments", { "[1," });
+  expectSceneError(creatureWith("tendrils: {legs: 3}"), at + "tendrils.legs", { "unknown key", "segments" });
+  expectSceneError(creatureWith("tendrils: {mass: 0}"), at + "tendrils.mass", { "> 0" });
+  expectSceneError(creatureWith("tendrils: {damping: -1}"), at + "tendrils.damping", { ">= 0" });
+  expectSceneError(creatureWith("tendrils: {direction: [0, 0, 0]}"), at + "tendrils.direction", { "zero" });
+  expectSceneError(creatureWith("tendrils: [1, 2]"), at + "tendrils", { "mapping" });
 }
 
 }  // namespace

@@ -13,6 +13,7 @@
 #include "soft_body_sim/core/bodies/limb.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "test_util.h"
+#include "scene_error.h"
 
 namespace soft_body_sim::test
 {
@@ -415,22 +416,6 @@ TEST(HumanoidScene, EveryKeyReachesTheBody)
                    buildHumanoid("h", HumanoidDef{}), "humanoid", true);
 }
 
-void expectError(const std::string& yaml, const std::string& location, const std::vector<std::string>& words)
-{
-  try
-  {
-    parseScene(yaml, "bad.yaml");
-    ADD_FAILURE() << "accepted:\n" << yaml;
-  }
-  catch (const SceneError& e)
-  {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-    EXPECT_EQ(message.rfind(location + ": ", 0), 0u) << message << "\nexpected start: " << location;
-    for (const std::string& word : words)
-      EXPECT_NE(message.find(word), std::string::npos) << message << "\nmissing: " << word;
-  }
-}
 
 /// A one-body scene of `type` whose 4th line is `line`.
 std::string bodyWith(const std::string& type, const std::string& line)
@@ -445,39 +430,39 @@ TEST(LimbScene, BadValuesAreRejectedWithOneLineAtTheKey)
   for (const std::string type : { "limb", "humanoid" })
   {
     SCOPED_TRACE(type);
-    expectError(bodyWith(type, "gravity: [0, 0]"), at + "gravity", { "3 numbers" });
-    expectError(bodyWith(type, "frame_period: 0"), at + "frame_period", { "> 0" });
-    expectError(bodyWith(type, "max_frames_per_step: -4"), at + "max_frames_per_step", { "> 0" });
-    expectError(bodyWith(type, "iterations: 0"), at + "iterations", { "[1," });
-    expectError(bodyWith(type, "iterations: 2.5"), at + "iterations", { "integer" });
-    expectError(bodyWith(type, "tension: 1"), at + "tension", { "(0, 1)" });
-    expectError(bodyWith(type, "tension: 0"), at + "tension", { "> 0" });
-    expectError(bodyWith(type, "retention: 1.2"), at + "retention", { "[0, 1]" });
-    expectError(bodyWith(type, "curve_samples: 1"), at + "curve_samples", { "[2," });
-    expectError(bodyWith(type, "elbow: 3"), at + "elbow", { "unknown key", "curve_samples" });
+    expectSceneError(bodyWith(type, "gravity: [0, 0]"), at + "gravity", { "3 numbers" });
+    expectSceneError(bodyWith(type, "frame_period: 0"), at + "frame_period", { "> 0" });
+    expectSceneError(bodyWith(type, "max_frames_per_step: -4"), at + "max_frames_per_step", { "> 0" });
+    expectSceneError(bodyWith(type, "iterations: 0"), at + "iterations", { "[1," });
+    expectSceneError(bodyWith(type, "iterations: 2.5"), at + "iterations", { "integer" });
+    expectSceneError(bodyWith(type, "tension: 1"), at + "tension", { "(0, 1)" });
+    expectSceneError(bodyWith(type, "tension: 0"), at + "tension", { "> 0" });
+    expectSceneError(bodyWith(type, "retention: 1.2"), at + "retention", { "[0, 1]" });
+    expectSceneError(bodyWith(type, "curve_samples: 1"), at + "curve_samples", { "[2," });
+    expectSceneError(bodyWith(type, "elbow: 3"), at + "elbow", { "unknown key", "curve_samples" });
   }
-  expectError(bodyWith("limb", "root: [0, 0, x]"), at + "root[2]", { "number" });
-  expectError(bodyWith("limb", "direction: [0, 0, 0]"), at + "direction", { "zero" });
-  expectError(bodyWith("limb", "upper_length: 0"), at + "upper_length", { "> 0" });
-  expectError(bodyWith("limb", "lower_length: -1"), at + "lower_length", { "> 0" });
-  expectError(bodyWith("limb", "target: [1, 2, 3]"), at + "target", { "unknown key" });
+  expectSceneError(bodyWith("limb", "root: [0, 0, x]"), at + "root[2]", { "number" });
+  expectSceneError(bodyWith("limb", "direction: [0, 0, 0]"), at + "direction", { "zero" });
+  expectSceneError(bodyWith("limb", "upper_length: 0"), at + "upper_length", { "> 0" });
+  expectSceneError(bodyWith("limb", "lower_length: -1"), at + "lower_length", { "> 0" });
+  expectSceneError(bodyWith("limb", "target: [1, 2, 3]"), at + "target", { "unknown key" });
 }
 
 TEST(HumanoidScene, BadValuesAreRejectedWithOneLineAtTheKey)
 {
   const std::string at = "bad.yaml:4: bodies[0].";
-  expectError(bodyWith("humanoid", "position: 3"), at + "position", { "3 numbers" });
-  expectError(bodyWith("humanoid", "up: [0, 0, 0]"), at + "up", { "zero" });
-  expectError(bodyWith("humanoid", "facing: [0, 0, 5]"), at + "facing", { "parallel to up" });
+  expectSceneError(bodyWith("humanoid", "position: 3"), at + "position", { "3 numbers" });
+  expectSceneError(bodyWith("humanoid", "up: [0, 0, 0]"), at + "up", { "zero" });
+  expectSceneError(bodyWith("humanoid", "facing: [0, 0, 5]"), at + "facing", { "parallel to up" });
   for (const std::string key : { "torso_length", "head_height", "shoulder_width", "hip_width", "arm_length",
                                  "leg_length" })
-    expectError(bodyWith("humanoid", key + ": 0"), at + key, { "> 0" });
-  expectError(bodyWith("humanoid", "torso_stiffness: -1"), at + "torso_stiffness", { ">= 0" });
+    expectSceneError(bodyWith("humanoid", key + ": 0"), at + key, { "> 0" });
+  expectSceneError(bodyWith("humanoid", "torso_stiffness: -1"), at + "torso_stiffness", { ">= 0" });
   // k T^2 = 1e5 / 3600 = 28 > 2 (1 + 0.9)
-  expectError(bodyWith("humanoid", "torso_stiffness: 100000"), at + "torso_stiffness", { "stable" });
-  expectError(bodyWith("humanoid", "torso_retention: 2"), at + "torso_retention", { "[0, 1]" });
+  expectSceneError(bodyWith("humanoid", "torso_stiffness: 100000"), at + "torso_stiffness", { "stable" });
+  expectSceneError(bodyWith("humanoid", "torso_retention: 2"), at + "torso_retention", { "[0, 1]" });
   // Parallel up and facing through `up` alone: reported at the body (line 2), from the core's check.
-  expectError(bodyWith("humanoid", "up: [1, 0, 0]"), "bad.yaml:2: bodies[0]", { "not parallel" });
+  expectSceneError(bodyWith("humanoid", "up: [1, 0, 0]"), "bad.yaml:2: bodies[0]", { "not parallel" });
 }
 
 }  // namespace

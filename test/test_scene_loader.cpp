@@ -1,6 +1,7 @@
 // Scene loader: a valid scene becomes exactly the expected structs; every invalid one is rejected with
 // a one-line message "<source>:<line>: <key path>: <reason>" that points at the offending value.
 #include "soft_body_sim/scene/scene_loader.h"
+#include "scene_error.h"
 
 #include <gtest/gtest.h>
 
@@ -16,29 +17,9 @@ namespace soft_body_sim
 {
 namespace
 {
-const char* const kSource = "bad.yaml";
 
 std::string sceneDir() { return std::string(SOURCE_DIR) + "/config/scenes"; }
 
-/// Parses `yaml` expecting a SceneError whose message is one line starting with "<location>: " and
-/// containing every word of `reason_words`.
-void expectSceneError(const std::string& yaml, const std::string& location,
-                      const std::vector<std::string>& reason_words)
-{
-  try
-  {
-    parseScene(yaml, kSource);
-    ADD_FAILURE() << "accepted:\n" << yaml;
-  }
-  catch (const SceneError& e)
-  {
-    const std::string message = e.what();
-    EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
-    EXPECT_EQ(message.rfind(location + ": ", 0), 0u) << "message: " << message << "\nexpected start: " << location;
-    for (const std::string& word : reason_words)
-      EXPECT_NE(message.find(word), std::string::npos) << "message: " << message << "\nmissing: " << word;
-  }
-}
 
 void expectVec3(const Vec3& actual, double x, double y, double z)
 {

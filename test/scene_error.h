@@ -1,0 +1,41 @@
+// Checks of the scene loader's error messages, shared by the loader's and the body types' tests.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "soft_body_sim/scene/scene_loader.h"
+
+namespace soft_body_sim
+{
+/// Runs `load` expecting a SceneError whose message is one line that starts with "<location>: " and
+/// contains every word of `reason_words`; `input` is shown if it is accepted.
+inline void expectSceneError(const std::function<void()>& load, const std::string& input, const std::string& location,
+                             const std::vector<std::string>& reason_words)
+{
+  try
+  {
+    load();
+    ADD_FAILURE() << "accepted:\n" << input;
+  }
+  catch (const SceneError& e)
+  {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << "not one line: " << message;
+    EXPECT_EQ(message.rfind(location + ": ", 0), 0u) << "message: " << message << "\nexpected start: " << location;
+    for (const std::string& word : reason_words)
+      EXPECT_NE(message.find(word), std::string::npos) << "message: " << message << "\nmissing: " << word;
+  }
+}
+
+/// The same for YAML text parsed as the file "bad.yaml".
+inline void expectSceneError(const std::string& yaml, const std::string& location,
+                             const std::vector<std::string>& reason_words)
+{
+  expectSceneError([&] { parseScene(yaml, "bad.yaml"); }, yaml, location, reason_words);
+}
+
+}  // namespace soft_body_sim
