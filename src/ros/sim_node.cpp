@@ -55,15 +55,15 @@ void SimNode::subscribeInputs()
   }
   for (const BodyDef& body : scene_.bodies)
   {
-    if (!body.controller)
+    if (body.type != "creature" && body.type != "humanoid")
       continue;
     const std::string topic = private_nh_.resolveName(body.name + "/target");
     const std::string name = body.name;
     subscribers_.push_back(private_nh_.subscribe<geometry_msgs::PoseStamped>(
         topic, 10, [this, topic, name](const geometry_msgs::PoseStamped::ConstPtr& pose) {
           Vec3 position;
-          if (toSceneFrame(*pose, topic, position) && !world_->setTarget(name, position))
-            ROS_WARN_THROTTLE(5.0, "%s: body '%s' takes no target; pose dropped", topic.c_str(), name.c_str());
+          if (toSceneFrame(*pose, topic, position))
+            world_->setTarget(name, position);
         }));
   }
 }
@@ -105,12 +105,14 @@ void SimNode::onTimer(const ros::TimerEvent&)
 {
   const ros::Time now = ros::Time::now();
   if (last_tick_.isZero())
-    last_tick_ = now;
+    last_tick_ = epoch_ = now;
   const double elapsed = std::max(0.0, (now - last_tick_).toSec());
   last_tick_ = now;
-  if (!paused_)
+  if (paused_)
+    epoch_ += ros::Duration(elapsed);  // simulated time stands still while ROS time goes on
+  else
     advance(elapsed);
-  publish(now);
+  publish(epoch_ + ros::Duration(world_->time()));
   if (status_period_ > 0.0 && (now - last_status_).toSec() >= status_period_)
     printStatus(now);
 }
@@ -134,6 +136,7 @@ void SimNode::advance(double elapsed)
   {
     ROS_WARN_THROTTLE(5.0, "soft_body_sim: falling behind real time: %.3f s of simulation dropped this tick",
                       (steps - max_steps_per_tick_) * dt);
+    epoch_ += ros::Duration(accumulator_ - max_steps_per_tick_ * dt);  // the dropped time
     steps = max_steps_per_tick_;
     accumulator_ = steps * dt;
   }
@@ -155,7 +158,7 @@ void SimNode::advance(double elapsed)
   }
 }
 
-void SimNode::publish(const ros::Time& now)
+void SimNode::publish(const ros::Time& stamp)
 {
   const State& state = world_->state();
   if (!state.position.allFinite() || !state.velocity.allFinite())
@@ -163,14 +166,15 @@ void SimNode::publish(const ros::Time& now)
     ROS_ERROR_THROTTLE(5.0, "soft_body_sim: the simulation holds non-finite values; nothing published");
     return;
   }
-  markers_publisher_.publish(RosConverter::toMarkers(*world_, scene_.frame_id, now));
-  state_publisher_.publish(RosConverter::toState(*world_, scene_.frame_id, now, statistics_));
+  markers_publisher_.publish(RosConverter::toMarkers(*world_, scene_.frame_id, stamp));
+  state_publisher_.publish(RosConverter::toState(*world_, scene_.frame_id, stamp, statistics_));
 }
 
 bool SimNode::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
 {
   world_ = std::make_unique<World>(buildWorld(scene_));
   accumulator_ = 0.0;
+  epoch_ = last_tick_;
   ROS_INFO("soft_body_sim: reset to the initial scene");
   return true;
 }

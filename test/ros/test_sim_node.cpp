@@ -2,6 +2,7 @@
 // poses through tf2, reset, pause, and bad input.
 #include <cmath>
 #include <functional>
+#include <vector>
 #include <limits>
 
 #include <geometry_msgs/PoseStamped.h>
@@ -48,6 +49,7 @@ protected:
         });
     state_sub_ = nh_.subscribe<SimState>("/soft_body_sim/state", 10, [this](const SimState::ConstPtr& s) {
       state_ = *s;
+      stamps_.push_back(s->header.stamp);
       ++state_count_;
     });
     start_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("/soft_body_sim/rope/start/pose", 10);
@@ -100,6 +102,7 @@ protected:
   ros::Publisher start_pub_, end_pub_;
   visualization_msgs::MarkerArray markers_;
   SimState state_;
+  std::vector<ros::Time> stamps_;
   int marker_count_ = 0;
   int state_count_ = 0;
 };
@@ -113,6 +116,14 @@ TEST_F(SimNodeTest, MarkersAndStateArriveAtTheConfiguredRateWithMatchingPosition
   // Timer jitter and delivery on a loaded 2-core machine: within 25 % of the rate.
   EXPECT_NEAR((state_count_ - states_before) / seconds, kRate, 0.25 * kRate);
   EXPECT_NEAR((marker_count_ - markers_before) / seconds, kRate, 0.25 * kRate);
+
+  // Stamps are simulated instants: they advance in whole steps of dt = 1 ms (to the stamp's 1 ns).
+  for (std::size_t k = stamps_.size() - 50; k < stamps_.size(); ++k)
+  {
+    const double advance = (stamps_[k] - stamps_[k - 1]).toSec();
+    EXPECT_GT(advance, 0.0);
+    EXPECT_NEAR(advance * 1000.0, std::round(advance * 1000.0), 1e-5) << "stamp advance " << advance << " s";
+  }
 
   ASSERT_TRUE(waitFor([this] { return markers_.markers.size() == 2 && markers_.markers[0].header.stamp == state_.header.stamp; }, 5.0));
   EXPECT_EQ(state_.header.frame_id, "world");

@@ -33,7 +33,8 @@ private:
   void onTimer(const ros::TimerEvent& event);
   /// Advances the accumulator by `elapsed` [s] of ROS time in fixed steps, at most max_steps_per_tick_.
   void advance(double elapsed);
-  void publish(const ros::Time& now);
+  /// Publishes markers and state stamped `stamp`, the ROS time of the simulated instant.
+  void publish(const ros::Time& stamp);
   void printStatus(const ros::Time& now);
 
   /// The pose's position in the scene frame; false (with a throttled warning naming `topic` and the
@@ -62,6 +63,9 @@ private:
   ros::Timer timer_;
 
   ros::Time last_tick_;
+  /// The ROS time of simulated time 0: the first tick, moved on by pauses, dropped catch-up and resets,
+  /// so that epoch_ + world time stamps each output with its simulated instant.
+  ros::Time epoch_;
   ros::Time last_status_;
   double accumulator_ = 0.0;  ///< [s] of ROS time not yet simulated
   double window_elapsed_ = 0.0;    ///< [s] of ROS time in the current real-time-factor window
