@@ -717,14 +717,12 @@ TEST(StabilityWarnings, TheStiffnessLimitIsEachSchemesOmegaH)
     {
       const double k = m * (omega_h / dt) * (omega_h / dt);
       const World world = dashpot(integrator, k, 0.0, dt);
-      const std::vector<std::string> warnings =
-          stabilityWarnings(world.model(), world.state(), integrator, world.settings());
+      std::vector<std::string> warnings;
+      for (const std::string& w : stabilityWarnings(world.model(), world.state(), integrator, world.settings()))
+        if (w.find("springs too stiff for the step") != std::string::npos)
+          warnings.push_back(w);
       const bool expected = isExplicit(integrator) && omega_h > limit;
-      ASSERT_EQ(warnings.size(), expected ? 1u : 0u) << integratorName(integrator) << " omega h = " << omega_h;
-      if (expected)
-      {
-        EXPECT_NE(warnings[0].find("springs too stiff for the step"), std::string::npos) << warnings[0];
-      }
+      EXPECT_EQ(warnings.size(), expected ? 1u : 0u) << integratorName(integrator) << " omega h = " << omega_h;
     }
   }
 }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include "soft_body_sim/core/forces.h"
@@ -114,6 +115,25 @@ std::vector<std::string> stabilityWarnings(const Model& model, const State& stat
                        format(std::sqrt(bounds.omega2_lower) * h) + " (h sqrt(k (1/m_a + 1/m_b)) of the stiffest spring) and " +
                        format(std::sqrt(bounds.omega2_upper) * h) +
                        " (h sqrt(max over nodes of sum k (1/m_a + 1/m_b)), cell pressure included)" + remedy);
+  if (type == IntegratorType::ExplicitEuler)
+  {
+    // A mode of rate omega and damping rate beta is amplified by |1 + h lambda|^2 = 1 - h beta + (h omega)^2
+    // per step: it grows unless h omega^2 < beta. Each spring's own mode (exact for one spring with a
+    // pinned end: omega^2 = k w, beta = c w + drag, w = 1/m_a + 1/m_b) is checked.
+    double worst = 0.0;
+    for (const Spring& spring : model.springs)
+    {
+      const double w = model.inverse_mass[spring.a] + model.inverse_mass[spring.b];
+      if (w == 0.0)
+        continue;
+      const double beta = spring.damping * w + model.drag;
+      worst = std::max(worst, beta > 0.0 ? h * spring.stiffness * w / beta : std::numeric_limits<double>::infinity());
+    }
+    if (worst >= 1.0)
+      warnings.push_back(name + ": under-damped springs gain energy at any step: a spring's mode grows unless h omega^2 " +
+                         "< beta (its damping rate c (1/m_a + 1/m_b) + drag), and the least damped spring has h omega^2 / " +
+                         "beta = " + format(worst) + step + remedy);
+  }
   return warnings;
 }
 

@@ -154,9 +154,6 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
   SceneDef scene = loadSceneFile(options.scene);
   applyOverrides(options, scene);
   World world = buildWorld(scene);
-  // Reported, not clamped: the run goes ahead with the scene as written.
-  for (const std::string& warning : stabilityWarnings(world.model(), world.state(), world.integrator(), world.settings()))
-    err << "simulate: warning: " << warning << '\n';
   const long long steps = std::llround(options.duration / scene.physics.step.dt);
 
   std::ofstream file;
@@ -166,6 +163,10 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
     if (!file)
       throw UsageError("--csv: cannot write '" + *options.csv + "'");
   }
+  // Reported, not clamped: the run goes ahead with the scene as written (after the last input check,
+  // so that bad input still gets its one line).
+  for (const std::string& warning : stabilityWarnings(world.model(), world.state(), world.integrator(), world.settings()))
+    err << "simulate: warning: " << warning << '\n';
   std::ostream& csv = options.csv ? file : out;
   csv << std::setprecision(17) << "t,body,node,x,y,z\n";
   writeRows(csv, world);
