@@ -319,5 +319,70 @@ TEST(HardCase11Extremes, MassesFromMicrogramsToKilotonnesOnGigaNewtonSpringsStay
   EXPECT_LT(xpbd.state().position(2, 4), -1.0) << "xpbd now holds the chain: tighten this test";
 }
 
+// --- dt: auto ------------------------------------------------------------------------------------
+
+TEST(AutoStep, IsStableAndWithinTwentyPercentOfTheLimitForOneSpring)
+{
+  // One spring with a pinned end: the bounds are exact (w = 1000 rad/s), so the chosen h is 0.9 of the
+  // true limit: bounded there, diverging at 1.2 times it (past the limit), i.e. not wastefully small.
+  for (IntegratorType integrator : { IntegratorType::SemiImplicitEuler, IntegratorType::Verlet,
+                                     IntegratorType::VelocityVerlet, IntegratorType::Rk4 })
+  {
+    SceneDef scene = hardCase("stiff_spring", integrator);
+    scene.physics.auto_dt = true;
+    World world = buildWorld(scene);
+    const double limit = integrator == IntegratorType::Rk4 ? 2.0 * std::sqrt(2.0) : 2.0;
+    EXPECT_NEAR(world.settings().dt * 1000.0, kAutoStepSafety * limit, 1e-12) << integratorName(integrator);
+    EXPECT_TRUE(warnings(world).empty()) << integratorName(integrator);
+    double largest = 0.0;
+    for (int n = 0; n < 20000; ++n)
+    {
+      world.step();
+      largest = std::max(largest, std::abs(world.state().position(0, 1) - 1.0));
+    }
+    EXPECT_LT(largest, 10e-3) << integratorName(integrator);
+
+    scene.physics.auto_dt = false;
+    scene.physics.step.dt = 1.2 * world.settings().dt;
+    World faster = buildWorld(scene);
+    bool diverged = false;
+    for (int n = 0; n < 2000 && !diverged; ++n)
+    {
+      faster.step();
+      diverged = !finite(faster) || std::abs(faster.state().position(0, 1) - 1.0) > 1.0;
+    }
+    EXPECT_TRUE(diverged) << integratorName(integrator) << " at 1.2 times the chosen step";
+  }
+}
+
+TEST(AutoStep, KeepsTheJellyDropStableAndIsReadFromTheSceneFile)
+{
+  const SceneDef scene = parseScene(R"(physics: {integrator: semi_implicit_euler, dt: auto}
+planes: [{point: [0, 0, 0], normal: [0, 0, 1]}]
+bodies:
+  - {name: jelly, type: jelly, nx: 4, ny: 4, top_left: [0, 0, 2.4], top_right: [0.4, 0, 2.4],
+     bottom_left: [0, 0, 2.0], mass: 1, edges: {stiffness: 2000, damping: 1}, diagonals: {stiffness: 1000, damping: 0.5},
+     pressure: 1000}
+)",
+                                    "auto.yaml");
+  ASSERT_TRUE(scene.physics.auto_dt);
+  World world = buildWorld(scene);
+  EXPECT_TRUE(warnings(world).empty());
+  for (int n = 0; n < std::lround(3.0 / world.settings().dt); ++n)
+  {
+    world.step();
+    ASSERT_TRUE(finite(world));
+    for (const PressureCell& cell : world.model().cells)
+      ASSERT_GT(cellArea(cell, world.state().position), 0.0);
+  }
+}
+
+TEST(AutoStep, ExplicitEulerWithAnUndampedSpringHasNoStableStep)
+{
+  SceneDef scene = hardCase("stiff_spring", IntegratorType::ExplicitEuler);
+  scene.physics.auto_dt = true;
+  EXPECT_THROW(buildWorld(scene), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace soft_body_sim::test

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "soft_body_sim/core/stability.h"
+
 #include "soft_body_sim/core/forces.h"
 
 namespace soft_body_sim
@@ -94,7 +96,10 @@ World buildWorld(const SceneDef& scene)
     model.bodies.push_back({ body.name, first, count });
     first += count;
   }
-  return World(std::move(model), std::move(state), scene.physics.integrator, scene.physics.step,
+  StepSettings step = scene.physics.step;
+  if (scene.physics.auto_dt)
+    step = chooseStableStep(model, state, scene.physics.integrator, step.iterations);
+  return World(std::move(model), std::move(state), scene.physics.integrator, step,
                std::move(controllers));
 }
 

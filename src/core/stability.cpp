@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <stdexcept>
 
 #include "soft_body_sim/core/forces.h"
 
@@ -89,6 +90,40 @@ RateBounds rateBounds(const Model& model, const State& state)
   bounds.damping_lower += model.drag;
   bounds.damping_upper += model.drag;
   return bounds;
+}
+
+StepSettings chooseStableStep(const Model& model, const State& state, IntegratorType type, int iterations)
+{
+  ExplicitLimits limits{};
+  const bool is_explicit = explicitLimits(type, limits);
+  const RateBounds bounds = rateBounds(model, state);
+  double h = std::numeric_limits<double>::infinity();
+  if (bounds.omega2_upper > 0.0)
+    h = std::min(h, kAutoStepSafety * (is_explicit ? limits.omega_h : 2.0) / std::sqrt(bounds.omega2_upper));
+  if (is_explicit && bounds.damping_upper > 0.0)
+    h = std::min(h, kAutoStepSafety / bounds.damping_upper);
+  if (type == IntegratorType::ExplicitEuler)
+  {
+    for (const Spring& spring : model.springs)
+    {
+      const double w = model.inverse_mass[spring.a] + model.inverse_mass[spring.b];
+      if (w == 0.0)
+        continue;
+      const double beta = spring.damping * w + model.drag;
+      if (!(beta > 0.0))
+        throw std::invalid_argument("physics.dt: auto: explicit_euler has no stable step for an undamped spring "
+                                    "(its energy grows by 1 + (omega h)^2 per step at any h); add damping or drag, "
+                                    "or choose another integrator");
+      h = std::min(h, kAutoStepSafety * beta / (spring.stiffness * w));
+    }
+  }
+  if (!std::isfinite(h))
+    h = kAutoStepUnlimited;
+  StepSettings settings;
+  settings.dt = h;
+  settings.substeps = 1;
+  settings.iterations = iterations;
+  return settings;
 }
 
 std::vector<std::string> stabilityWarnings(const Model& model, const State& state, IntegratorType type,

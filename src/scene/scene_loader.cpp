@@ -40,7 +40,13 @@ PhysicsDef readPhysics(const Context& ctx, const Field& field)
   if (const std::optional<Field> value = optionalKey(field, "integrator"))
     physics.integrator = readIntegrator(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "dt"))
-    physics.step.dt = readPositive(ctx, *value);
+  {
+    // `auto`: the world picks a stable step from the scene's stiffest spring (chooseStableStep).
+    if (value->node.IsScalar() && value->node.Tag() != "!" && value->node.Scalar() == "auto")
+      physics.auto_dt = true;
+    else
+      physics.step.dt = readPositive(ctx, *value);
+  }
   if (const std::optional<Field> value = optionalKey(field, "substeps"))
     physics.step.substeps = readAtLeastOne(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "iterations"))

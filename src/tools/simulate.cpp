@@ -32,6 +32,7 @@ struct Options
   double duration = 1.0;  ///< [s]
   std::optional<std::string> integrator;
   std::optional<double> dt;
+  bool auto_dt = false;  ///< --dt auto
   std::optional<int> substeps;
   std::optional<int> iterations;
   std::optional<long long> every;
@@ -99,12 +100,15 @@ Options parseOptions(const std::vector<std::string>& args)
   }
   if (values.count("--integrator"))
     options.integrator = values["--integrator"];
-  if (values.count("--dt"))
+  if (values.count("--dt") && values["--dt"] == "auto")
+    options.auto_dt = true;
+  else if (values.count("--dt"))
   {
     options.dt = parseNumber("--dt", values["--dt"]);
     if (!(*options.dt > 0.0))
-      throw UsageError("--dt: must be > 0, got '" + values["--dt"] + "'");
+      throw UsageError("--dt: must be > 0 or auto, got '" + values["--dt"] + "'");
   }
+
   const long long int_max = std::numeric_limits<int>::max();
   if (values.count("--substeps"))
     options.substeps = static_cast<int>(std::min(int_max, parsePositiveInteger("--substeps", values["--substeps"])));
@@ -129,7 +133,12 @@ void applyOverrides(const Options& options, SceneDef& scene)
     throw UsageError("--integrator: unknown integrator '" + *options.integrator + "' (valid: " + valid + ")");
   }
   if (options.dt)
+  {
     scene.physics.step.dt = *options.dt;
+    scene.physics.auto_dt = false;
+  }
+  if (options.auto_dt)
+    scene.physics.auto_dt = true;
   if (options.substeps)
     scene.physics.step.substeps = *options.substeps;
   if (options.iterations)
@@ -154,7 +163,7 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
   SceneDef scene = loadSceneFile(options.scene);
   applyOverrides(options, scene);
   World world = buildWorld(scene);
-  const long long steps = std::llround(options.duration / scene.physics.step.dt);
+  const long long steps = std::llround(options.duration / world.settings().dt);
 
   std::ofstream file;
   if (options.csv)
@@ -163,6 +172,9 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
     if (!file)
       throw UsageError("--csv: cannot write '" + *options.csv + "'");
   }
+  if (scene.physics.auto_dt)
+    err << "simulate: note: dt auto chose dt = " << world.settings().dt << " s in " << world.settings().substeps
+        << " sub-step(s) for " << integratorName(world.integrator()) << '\n';
   // Reported, not clamped: the run goes ahead with the scene as written (after the last input check,
   // so that bad input still gets its one line).
   for (const std::string& warning : stabilityWarnings(world.model(), world.state(), world.integrator(), world.settings()))

@@ -73,6 +73,8 @@ struct PhysicsDef
 {
   IntegratorType integrator = IntegratorType::SemiImplicitEuler;
   StepSettings step;                        ///< dt [s], substeps, iterations
+  /// `dt: auto`: buildWorld replaces step.dt and step.substeps by chooseStableStep's (stability.h).
+  bool auto_dt = false;
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);     ///< [m/s^2]
   double drag = 0.0;                        ///< [1/s]
 };

@@ -50,4 +50,18 @@ RateBounds rateBounds(const Model& model, const State& state);
 std::vector<std::string> stabilityWarnings(const Model& model, const State& state, IntegratorType type,
                                            const StepSettings& settings);
 
+/// Safety factor of chooseStableStep: the step stays this fraction of the limit it meets first.
+constexpr double kAutoStepSafety = 0.9;
+/// The step of a scene without springs or cells, where nothing limits it [s].
+constexpr double kAutoStepUnlimited = 0.01;
+
+/// The `dt: auto` step for `type`: one sub-step of the largest h that keeps, from RateBounds' upper
+/// bounds, omega_max h at kAutoStepSafety times the scheme's limit (2, or 2 sqrt(2) for rk4; 2 also for
+/// implicit_euler and xpbd, stable at any step but no longer following the fastest mode past it), and
+/// for the explicit schemes h beta_max at kAutoStepSafety; explicit Euler also needs every spring's
+/// h omega^2 below its damping rate beta. So stabilityWarnings stays silent at the chosen step, and the
+/// step is within 1 / kAutoStepSafety of the bound it meets (exact for one spring with a pinned end).
+/// Throws std::invalid_argument for explicit Euler with an undamped spring: no step is stable.
+StepSettings chooseStableStep(const Model& model, const State& state, IntegratorType type, int iterations);
+
 }  // namespace soft_body_sim
