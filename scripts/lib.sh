@@ -17,8 +17,14 @@ PACKAGES=(
   python3-rostest librostest-dev python3-roslaunch python3-rostopic python3-rosbag
   libeigen3-dev libyaml-cpp-dev
   googletest libgtest-dev libbenchmark-dev
+  clang libclang-rt-14-dev
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
+  libinteractive-markers-dev libdiagnostic-updater-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
+  rosbash python3-rospy python3-rosbag python3-rosservice python3-tf2-ros python3-std-srvs python3-geometry-msgs
+  python3-visualization-msgs python3-diagnostic-msgs python3-rosgraph-msgs
+  rviz xvfb libgl1-mesa-dri python3-pil
 )
-# What only the demo needs on top: rviz.
+# What only the demo needs on top: rviz (already in PACKAGES for the rviz screenshot test).
 DEMO_PACKAGES=(rviz)
 
 log() { printf '[%s] %s\n' "$(basename "$0")" "$*" >&2; }

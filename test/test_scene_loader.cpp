@@ -823,6 +823,20 @@ bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
     anchors: [{name: end}]
 )",
     "bad.yaml:5: bodies[0].anchors[0].node", { "missing required key" } },
+  { "AnchorFrameWithLeadingSlash", R"(bodies:
+  - name: b
+    type: custom
+    nodes: [{position: [0, 0, 0], mass: 1}]
+    anchors: [{name: end, node: 0, frame: /gripper_link}]
+)",
+    "bad.yaml:5: bodies[0].anchors[0].frame", { "'/gripper_link' must not start with '/'" } },
+  { "AnchorFrameEmpty", R"(bodies:
+  - name: b
+    type: custom
+    nodes: [{position: [0, 0, 0], mass: 1}]
+    anchors: [{name: end, node: 0, frame: ""}]
+)",
+    "bad.yaml:5: bodies[0].anchors[0].frame", { "empty" } },
   { "MultiLineValueStaysOneLine", R"(physics:
   integrator: "semi\nimplicit"
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
@@ -843,6 +857,23 @@ TEST_P(BadSceneTest, IsRejectedWithSourceLineKeyPathAndReason)
 INSTANTIATE_TEST_SUITE_P(SceneLoader, BadSceneTest, ::testing::ValuesIn(kBadScenes),
                          [](const ::testing::TestParamInfo<BadScene>& info) { return std::string(info.param.name); });
 
+TEST(SceneLoader, HugeBodiesAreRefusedBeforeTheyExhaustMemory)
+{
+  // Two ropes of 600,000 nodes each: 1.2 million nodes, over the scene's limit of one million.
+  const std::string rope = "{type: rope, nodes: 600000, from: [0, 0, 0], to: [1, 0, 0], mass: 1, stiffness: 1}";
+  expectSceneError("bodies:\n  - " + rope.substr(0, rope.size() - 1) + ", name: a}\n  - " +
+                       rope.substr(0, rope.size() - 1) + ", name: b}\n",
+                   "bad.yaml:3: bodies[1]", { "1200000 nodes", "more than 1000000" });
+  expectSceneError(R"(bodies:
+  - {name: c, type: creature, tendrils: {segments: 2000000000}}
+)",
+                   "bad.yaml:2: bodies[0].tendrils.segments", { "[1, 500000]" });
+  expectSceneError(R"(bodies:
+  - {name: l, type: limb, curve_samples: 2000000000}
+)",
+                   "bad.yaml:2: bodies[0].curve_samples", { "[2, 10000]" });
+}
+
 TEST(SceneLoader, RateIsReadWithADefaultOfSixtyHertz)
 {
   const char* const body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";
@@ -859,7 +890,7 @@ bodies:
   - name: b
     type: custom
     nodes: [{position: [0, 0, 0], mass: 1}, {position: [1, 0, 0], mass: 1}, {position: [2, 0, 0], mass: 1}]
-    anchors: [{name: first, node: 0}, {name: last, node: -1}]
+    anchors: [{name: first, node: 0}, {name: last, node: -1, frame: gripper_link}]
 )",
                                     "planes.yaml");
   ASSERT_EQ(scene.planes.size(), 2u);
@@ -874,6 +905,8 @@ bodies:
   EXPECT_EQ(body.anchors[0].name, "first");
   EXPECT_EQ(body.anchors[0].node, 0);
   EXPECT_EQ(body.anchors[1].node, 2);
+  EXPECT_EQ(body.anchors[0].frame, "");  // moved by its pose topic
+  EXPECT_EQ(body.anchors[1].frame, "gripper_link");
 
   // Anchored nodes are pinned in the world.
   const World world = buildWorld(scene);

@@ -17,6 +17,10 @@ namespace soft_body_sim::scene_yaml
 {
 using BodyReader = BodyDef (*)(const Context& ctx, const Field& body);
 
+/// The most nodes a scene may have, in all its bodies: a typo such as `nx: 100000` or
+/// `segments: 1e9` fails with a message rather than exhausting memory.
+constexpr long long kMaxSceneNodes = 1000000;
+
 struct BodyType
 {
   const char* name;

@@ -20,7 +20,7 @@ using namespace scene_yaml;
 const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "bodies" };
 const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag" };
 const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
-const Keys kAnchorKeys = { "name", "node" };
+const Keys kAnchorKeys = { "name", "node", "frame" };
 
 // --- scene parts -------------------------------------------------------------------------------
 
@@ -99,6 +99,13 @@ void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
       ctx.fail(node, "node index " + std::to_string(index) + " out of range; the body has " + std::to_string(count) +
                          " nodes (" + std::to_string(-n) + ".." + std::to_string(n - 1) + ")");
     anchor.node = static_cast<int>(index < 0 ? index + n : index);
+    if (const std::optional<Field> frame = optionalKey(item, "frame"))
+    {
+      anchor.frame = readNonEmptyString(ctx, *frame);
+      // tf2 rejects frame ids with a leading slash (a tf1 habit): say so here, not at run time.
+      if (anchor.frame.front() == '/')
+        ctx.fail(*frame, "tf frame " + quoted(anchor.frame) + " must not start with '/'");
+    }
     body.anchors.push_back(anchor);
   }
 }
@@ -145,9 +152,14 @@ SceneDef readScene(const Context& ctx, const Field& root)
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error
+  long long nodes = 0;
   for (const Field& item : requireList(ctx, bodies))
   {
     scene.bodies.push_back(readBody(ctx, item));
+    nodes += static_cast<long long>(scene.bodies.back().nodes.size());
+    if (nodes > kMaxSceneNodes)
+      ctx.fail(item, "the scene would have " + std::to_string(nodes) + " nodes, more than " +
+                         std::to_string(kMaxSceneNodes));
     const std::string& name = scene.bodies.back().name;
     const auto [first, inserted] = path_by_name.emplace(name, item.path);
     if (!inserted)

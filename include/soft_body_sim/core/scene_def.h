@@ -4,6 +4,7 @@
 
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "soft_body_sim/core/controller.h"
@@ -51,8 +52,15 @@ struct CellDef
 /// A named node that the caller moves (World::moveAnchor); the node is pinned.
 struct AnchorDef
 {
+  AnchorDef() = default;
+  AnchorDef(std::string name_, int node_, std::string frame_ = {})
+    : name(std::move(name_)), node(node_), frame(std::move(frame_))
+  {
+  }
+
   std::string name;
-  int node = 0;  ///< node index within the body
+  int node = 0;       ///< node index within the body
+  std::string frame;  ///< a tf frame whose origin the ROS node makes it follow; empty = its pose topic
 };
 
 /// Any body, as nodes, springs and constraints. Generated body types (rope, cloth, ...) expand into

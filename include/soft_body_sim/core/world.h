@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,6 +21,18 @@ struct BodyController
   std::unique_ptr<Controller> controller;
 };
 
+/// Live multipliers of one body's material, relative to the scene's values (the jelly seed's sliders
+/// "to make it more springy or viscous"). 1 = as loaded; each > 0.
+struct BodyScaling
+{
+  double stiffness = 1.0;  ///< [-] spring stiffness k, and constraint stiffness 1 / compliance
+  double damping = 1.0;    ///< [-] spring dashpots c
+  double pressure = 1.0;   ///< [-] rest gas pressure p0 of the body's cells
+};
+
+/// Where an anchor should be at simulated time t [s]; nullopt leaves it where it is.
+using AnchorPath = std::function<std::optional<Vec3>(double t)>;
+
 class World
 {
 public:
@@ -32,8 +45,9 @@ public:
   /// the integrator steps, planes push nodes out.
   void step();
 
-  /// Simulated time [s] = number of steps taken * dt (no accumulated round-off).
-  double time() const { return static_cast<double>(steps_) * settings_.dt; }
+  /// Simulated time [s] = number of steps taken * dt (no accumulated round-off); after setStepSettings,
+  /// the time of that change + the steps since * the new dt.
+  double time() const { return time_origin_ + static_cast<double>(steps_ - steps_origin_) * settings_.dt; }
   std::int64_t stepCount() const { return steps_; }
 
   const Model& model() const { return model_; }
@@ -53,12 +67,47 @@ public:
   /// Sets a node's position [m] and velocity [m/s] directly.
   void setNode(int node, const Vec3& position, const Vec3& velocity);
 
+  // --- live tuning: each takes effect at the next step; positions and velocities do not jump -------
+  /// New dt [s] (> 0), substeps and iterations (>= 1); simulated time goes on from time(). Throws
+  /// std::invalid_argument on a bad value and keeps the old settings.
+  void setStepSettings(const StepSettings& settings);
+  /// Switches the integrator; the new one starts from the current positions and velocities.
+  void setIntegrator(IntegratorType type);
+  /// [m/s^2], finite; throws std::invalid_argument otherwise.
+  void setGravity(const Vec3& gravity);
+  /// Linear air drag [1/s], finite and >= 0; throws std::invalid_argument otherwise.
+  void setDrag(double drag);
+  /// Scales body `body`'s springs, constraints and cells from the values it was built with; false if
+  /// there is no such body. Throws std::invalid_argument if a factor is out of range (see BodyScaling).
+  bool setBodyScaling(const std::string& body, const BodyScaling& scaling);
+  /// The scaling last set for `body` (all 1 if never set or unknown).
+  BodyScaling bodyScaling(const std::string& body) const;
+
+  // --- anchors that follow a path, and grasping -----------------------------------------------------
+  /// Every step, the anchor moves (as by moveAnchor) to path(t) at the step's end time t; an empty path
+  /// stops following. A moveAnchor call before a step overrides the path for that step only.
+  void followPath(int anchor, AnchorPath path);
+  /// The free node of `body` (any body if empty) nearest to `point` [m] within `radius` [m], or nullopt.
+  std::optional<int> nearestFreeNode(const Vec3& point, const std::string& body, double radius) const;
+  /// Grasps free node `node`: pins it as a new anchor `name` of its body and returns the anchor's index
+  /// (after the scene's anchors). It holds still until moved or given a path. Throws
+  /// std::invalid_argument if the node is out of range or pinned, or its body has an anchor `name`.
+  int attach(int node, const std::string& name);
+  /// Releases an anchor made by attach: its node is free again and keeps the anchor's last velocity,
+  /// as a gripper lets go. Anchors after it move down one index. False for a scene anchor or an index
+  /// out of range.
+  bool detach(int anchor);
+  /// True for an anchor made by attach.
+  bool isAttached(int anchor) const;
+
   /// Kinetic + potential energy [J] (see forces.h).
   double energy() const;
 
 private:
   /// Controllers and anchors set their nodes for this step; true if any kinematic node moves.
   bool driveKinematicNodes(double dt);
+  /// Index into model().bodies of the body holding `node`.
+  std::size_t bodyOf(int node) const;
 
   Model model_;
   State state_;
@@ -67,6 +116,16 @@ private:
   std::unique_ptr<Integrator> integrator_;
   std::vector<BodyController> controllers_;
   std::vector<std::optional<Vec3>> anchor_goals_;  ///< per anchor: where to be at the end of the next step
+  std::vector<AnchorPath> anchor_paths_;            ///< per anchor: followed every step if set
+  std::size_t scene_anchors_ = 0;                   ///< anchors [0, scene_anchors_) came with the scene
+  /// The material as built, which BodyScaling multiplies: per spring k and c, per constraint compliance,
+  /// per cell pressure, and the scaling of each body.
+  std::vector<Spring> built_springs_;
+  std::vector<DistanceConstraint> built_constraints_;
+  std::vector<PressureCell> built_cells_;
+  std::vector<BodyScaling> body_scaling_;
+  double time_origin_ = 0.0;        ///< [s] simulated time at the last change of dt
+  std::int64_t steps_origin_ = 0;   ///< step count then
   std::vector<std::uint8_t> touching_;              ///< per node: on a plane after the last sub-step
   std::int64_t steps_ = 0;
 };

@@ -1,12 +1,18 @@
-// The ROS node over the core: a timer advances the World in fixed steps and publishes markers and
-// state; anchor and target poses arrive on topics in any tf frame; services reset and pause.
+// The ROS node over the core: a timer advances the World in fixed steps and publishes markers, state
+// and diagnostics; anchor and target poses arrive on topics (or from rviz handles) in any tf frame and
+// take effect at the step their stamp falls in; anchors may follow tf frames; dynamic_reconfigure tunes
+// the physics live; services reset, pause, attach and detach. The same class runs as a node
+// (sim_node_main.cpp) and as a nodelet (sim_nodelet.cpp).
 #pragma once
 
 #include <chrono>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include <diagnostic_updater/diagnostic_updater.h>
 #include <geometry_msgs/PoseStamped.h>
 #include <ros/ros.h>
 #include <std_srvs/Empty.h>
@@ -14,7 +20,14 @@
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/transform_listener.h>
 
+#include "soft_body_sim/Attach.h"
+#include "soft_body_sim/BodyConfig.h"
+#include "soft_body_sim/Detach.h"
+#include "soft_body_sim/SimConfig.h"
 #include "soft_body_sim/core/scene_def.h"
+#include "soft_body_sim/ros/anchor_handles.h"
+#include "soft_body_sim/ros/input_schedule.h"
+#include "soft_body_sim/ros/reconfigure_server.h"
 #include "soft_body_sim/ros/ros_converter.h"
 
 namespace soft_body_sim
@@ -23,30 +36,61 @@ class SimNode
 {
 public:
   /// @param nh the node's namespace handle; @param private_nh its private (~) handle
-  SimNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh);
+  /// @param name the node's (or nodelet's) name, for diagnostics and log lines
+  SimNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, const std::string& name = ros::this_node::getName());
 
-  /// Loads the scene named by ~scene with the package's loader, then creates the topics, services and
-  /// the timer. Throws SceneError (or std::runtime_error) with one clear line if it cannot start.
+  /// Loads the scene named by ~scene with the package's loader, then creates the topics, services,
+  /// handles, reconfigure servers and the timer. Throws SceneError (or std::runtime_error) with one
+  /// clear line if it cannot start.
   void initialize();
 
 private:
+  // --- time (sim_node.cpp)
   void onTimer(const ros::TimerEvent& event);
-  /// Advances the accumulator by `elapsed` [s] of ROS time in fixed steps, at most max_steps_per_tick_.
-  void advance(double elapsed);
-  /// Publishes markers and state stamped `stamp`, the ROS time of the simulated instant.
-  void publish(const ros::Time& stamp);
+  /// Simulates whole steps up to `now`, at most max_steps_per_tick_ of them (no cap under /use_sim_time).
+  void advance(const ros::Time& now, double elapsed);
+  /// The ROS time of the simulated instant world time `t` [s].
+  ros::Time rosTime(double t) const { return epoch_ + ros::Duration(t); }
+  /// Publishes markers and state stamped with the ROS time of the simulated instant, and the handles.
+  void publish();
   void printStatus(const ros::Time& now);
+  /// Builds the world from the scene and re-applies the live tuning and the tf-following anchors.
+  void buildWorldFromScene();
 
+  // --- inputs (sim_node_inputs.cpp)
+  void subscribeInputs();
+  void addHandles();
+  /// Queues an input for the step its stamp falls in; stamp 0 means now.
+  void schedule(const std::string& topic, const ros::Time& stamp, const ScheduledInput& input);
+  void applyDueInputs(const ros::Time& step_end);
   /// The pose's position in the scene frame; false (with a throttled warning naming `topic` and the
   /// reason) if it is not finite or its frame cannot be transformed.
   bool toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position);
-  void subscribeInputs();
+  /// The origin of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf
+  /// has none that recent yet); nullopt with a throttled warning if tf has none at all.
+  std::optional<Vec3> frameOrigin(const std::string& frame, const ros::Time& stamp);
+  /// Makes anchor `anchor` follow tf frame `frame` every step.
+  void followFrame(int anchor, const std::string& frame);
+  bool onAttach(Attach::Request& request, Attach::Response& response);
+  bool onDetach(Detach::Request& request, Detach::Response& response);
+
+  // --- tuning and health (sim_node_tuning.cpp)
+  void startReconfigure();
+  /// Applies `config` to the world; an empty string, or why it cannot.
+  std::string applySimConfig(const SimConfig& config);
+  std::string applyBodyConfig(const std::string& body, const BodyConfig& config);
+  SimConfig simConfigFromWorld() const;
+  void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
+  /// Counts a divergence event when the state turns non-finite or over-stretched.
+  void watchDivergence();
 
   bool onReset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
+  std::string name_;
+  std::string scene_path_;
   SceneDef scene_;
   std::unique_ptr<World> world_;
   double rate_ = 60.0;          ///< [Hz] of the timer
@@ -57,21 +101,39 @@ private:
   tf2_ros::TransformListener tf_listener_;
   ros::Publisher markers_publisher_;
   ros::Publisher state_publisher_;
+  ros::Publisher start_time_publisher_;
   std::vector<ros::Subscriber> subscribers_;
   ros::ServiceServer reset_service_;
   ros::ServiceServer pause_service_;
+  ros::ServiceServer attach_service_;
+  ros::ServiceServer detach_service_;
   ros::Timer timer_;
+  std::unique_ptr<AnchorHandles> handles_;
+  std::unique_ptr<ReconfigureServer<SimConfig>> sim_reconfigure_;
+  /// (body name, its server) per tunable body
+  std::vector<std::pair<std::string, std::unique_ptr<ReconfigureServer<BodyConfig>>>> body_reconfigure_;
+  std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
 
+  InputSchedule inputs_;
+  std::vector<std::string> handle_names_;  ///< per scene anchor: its handle ("" = follows a frame)
+  std::vector<std::pair<std::string, std::string>> target_handles_;  ///< (body, handle) per target
+  std::vector<std::pair<std::string, Vec3>> targets_;  ///< last target set per body [m]
+
+  bool started_ = false;
+  std::optional<ros::Time> start_time_;  ///< ~start_time: the ROS time of simulated time 0, if given
   ros::Time last_tick_;
-  /// The ROS time of simulated time 0: the first tick, moved on by pauses, dropped catch-up and resets,
-  /// so that epoch_ + world time stamps each output with its simulated instant.
+  /// The ROS time of simulated time 0: the first tick (to the millisecond) or ~start_time, moved on by
+  /// pauses, dropped catch-up and resets, so that epoch_ + world time stamps each output.
   ros::Time epoch_;
+  ros::Time published_epoch_;
   ros::Time last_status_;
-  double accumulator_ = 0.0;  ///< [s] of ROS time not yet simulated
   double window_elapsed_ = 0.0;    ///< [s] of ROS time in the current real-time-factor window
   double window_simulated_ = 0.0;  ///< [s] simulated in it
   bool paused_ = false;
   StepStatistics statistics_;
+  double max_strain_ = 0.0;       ///< [-] largest |l - L| / L of a spring or constraint, last tick
+  bool diverged_ = false;         ///< the state is non-finite or over-stretched now
+  int divergence_events_ = 0;     ///< times it became so
 };
 
 }  // namespace soft_body_sim

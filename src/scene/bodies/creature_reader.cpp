@@ -46,7 +46,13 @@ TendrilDef readTendrils(const Context& ctx, const Field& field)
   requireMap(ctx, field, kTendrilKeys);
   TendrilDef tendrils;
   if (const std::optional<Field> value = optionalKey(field, "segments"))
-    tendrils.segments = readAtLeastOne(ctx, *value);
+  {
+    const long long segments = readInteger(ctx, *value);
+    if (segments < 1 || segments > kMaxSceneNodes / 2)  // two tendrils
+      ctx.fail(*value, "must be an integer in [1, " + std::to_string(kMaxSceneNodes / 2) + "], got " +
+                           value->node.Scalar());
+    tendrils.segments = static_cast<int>(segments);
+  }
   if (const std::optional<Field> value = optionalKey(field, "length"))
     tendrils.length = readPositive(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "mass"))

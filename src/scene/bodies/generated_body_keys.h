@@ -10,9 +10,8 @@
 
 namespace soft_body_sim::scene_yaml
 {
-/// The most nodes a generated body may have: a typo such as `nx: 100000` fails here with a message
-/// rather than exhausting memory.
-constexpr long long kMaxGeneratedNodes = 1000000;
+/// The most nodes a generated body may have (see kMaxSceneNodes).
+constexpr long long kMaxGeneratedNodes = kMaxSceneNodes;
 
 /// An integer count in [minimum, kMaxGeneratedNodes].
 inline int readCount(const Context& ctx, const Field& field, long long minimum)

@@ -1,6 +1,5 @@
 // `type: limb`: one 3-particle Verlet limb of verlet-bezier-limbs.txt (see core/bodies/limb.h), and the
 // limb-motion keys it shares with `humanoid`.
-#include <climits>
 #include <stdexcept>
 
 #include "../body_readers.h"
@@ -53,8 +52,10 @@ void readLimbMotion(const Context& ctx, const Field& body, LimbMotion& motion)
   if (const std::optional<Field> value = optionalKey(body, "curve_samples"))
   {
     const long long samples = readInteger(ctx, *value);
-    if (samples < 2 || samples > INT_MAX)
-      ctx.fail(*value, "must be an integer in [2, " + std::to_string(INT_MAX) + "], got " + value->node.Scalar());
+    // Every published marker carries the curve: a few dozen points draw it smoothly.
+    constexpr long long kMaxCurveSamples = 10000;
+    if (samples < 2 || samples > kMaxCurveSamples)
+      ctx.fail(*value, "must be an integer in [2, " + std::to_string(kMaxCurveSamples) + "], got " + value->node.Scalar());
     motion.curve_samples = static_cast<int>(samples);
   }
 }

@@ -1,0 +1,146 @@
+#!/usr/bin/python3
+"""Inputs the ROS way (launched by inputs.test on frame_test_scene.yaml): the rope's first node follows
+the tf frame gripper_link, its last node has an rviz handle, and ~attach / ~detach grasp and release
+a node at another frame."""
+import math
+import threading
+import unittest
+
+import rospy
+import rostest
+import tf2_ros
+from geometry_msgs.msg import PoseStamped, TransformStamped
+from std_srvs.srv import SetBool
+from visualization_msgs.msg import InteractiveMarkerFeedback, InteractiveMarkerInit
+
+from node_client import StateWatcher, wait_for
+from soft_body_sim.srv import Attach, Detach
+
+NODE = "/soft_body_sim"
+GRIPPER_CENTER = (0.0, 0.0, 1.0)  # [m] the gripper circles about this point in the x-z plane
+GRIPPER_RADIUS = 0.1              # [m]
+GRIPPER_PERIOD = 4.0              # [s] one turn: 0.16 m/s
+
+
+def gripper_position(t):
+    w = 2.0 * math.pi / GRIPPER_PERIOD
+    return (GRIPPER_CENTER[0] + GRIPPER_RADIUS * math.cos(w * t), GRIPPER_CENTER[1],
+            GRIPPER_CENTER[2] + GRIPPER_RADIUS * math.sin(w * t))
+
+
+class InputsTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        rospy.init_node("test_inputs")
+        cls.state = StateWatcher()
+        cls.frames = {}  # child frame -> fixed position; gripper_link moves on its circle
+        cls.lock = threading.Lock()
+        cls.broadcaster = tf2_ros.TransformBroadcaster()
+        cls.timer = rospy.Timer(rospy.Duration(0.02), cls._broadcast)
+        cls.handles = None
+        rospy.Subscriber(NODE + "/handles/update_full", InteractiveMarkerInit,
+                         lambda m: setattr(cls, "handles", m), queue_size=1)
+        cls.end_poses = []
+        rospy.Subscriber(NODE + "/rope/end/pose", PoseStamped, cls.end_poses.append, queue_size=10)
+        cls.feedback = rospy.Publisher(NODE + "/handles/feedback", InteractiveMarkerFeedback, queue_size=10)
+        rospy.wait_for_service(NODE + "/attach", 20.0)
+        cls.attach = rospy.ServiceProxy(NODE + "/attach", Attach)
+        cls.detach = rospy.ServiceProxy(NODE + "/detach", Detach)
+        cls.state.next(1, 20.0)
+
+    @classmethod
+    def _broadcast(cls, _event):
+        now = rospy.Time.now()
+        with cls.lock:
+            frames = dict(cls.frames)
+        frames["gripper_link"] = gripper_position(now.to_sec())
+        transforms = []
+        for child, (x, y, z) in frames.items():
+            t = TransformStamped()
+            t.header.stamp = now
+            t.header.frame_id = "world"
+            t.child_frame_id = child
+            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
+            t.transform.rotation.w = 1.0
+            transforms.append(t)
+        cls.broadcaster.sendTransform(transforms)
+
+    def set_frame(self, child, position):
+        with self.lock:
+            self.frames[child] = position
+
+    def test_an_anchor_follows_its_tf_frame(self):
+        # Each step's end asks tf for the frame at that instant (the latest transform when the step is
+        # ahead of tf's data, up to one 20 ms broadcast period plus transport: 0.16 m/s * 50 ms = 8 mm).
+        self.state.next(25)
+        errors = []
+        for _ in range(50):
+            s = self.state.next(1)
+            x = s.bodies[0].positions[0]
+            errors.append(math.dist((x.x, x.y, x.z), gripper_position(s.header.stamp.to_sec())))
+        self.assertLess(max(errors), 0.01, errors)
+
+    def test_a_handle_drag_publishes_on_the_anchor_topic_and_moves_the_anchor(self):
+        self.assertTrue(wait_for(lambda: self.handles is not None, 10.0))
+        # A handle for the topic anchor; none for the anchor that follows its frame.
+        self.assertEqual(sorted(m.name for m in self.handles.markers), ["rope/end"])
+        handle = self.handles.markers[0]
+        self.assertEqual(handle.header.frame_id, "world")
+        self.assertAlmostEqual(handle.pose.position.x, 0.4)
+        feedback = InteractiveMarkerFeedback()
+        feedback.header.frame_id = "world"
+        feedback.client_id = "/test_inputs/rviz"
+        feedback.marker_name = "rope/end"
+        feedback.control_name = "move_3d"
+        feedback.event_type = InteractiveMarkerFeedback.POSE_UPDATE
+        feedback.pose.position.x, feedback.pose.position.y, feedback.pose.position.z = 0.6, 0.1, 1.1
+        feedback.pose.orientation.w = 1.0
+        self.assertTrue(wait_for(lambda: self.feedback.get_num_connections() > 0, 10.0))
+        self.feedback.publish(feedback)
+        # The same pose on the anchor's topic, as another node would send it, stamped now ...
+        self.assertTrue(wait_for(lambda: self.end_poses, 10.0))
+        pose = self.end_poses[-1]
+        self.assertEqual(pose.header.frame_id, "world")
+        self.assertGreater(pose.header.stamp.to_sec(), 0.0)
+        self.assertEqual((pose.pose.position.x, pose.pose.position.y, pose.pose.position.z), (0.6, 0.1, 1.1))
+        # ... and the anchored node goes exactly there.
+        self.assertTrue(wait_for(lambda: self.state.node("rope", 4) == (0.6, 0.1, 1.1), 10.0), self.state.node("rope", 4))
+
+    def test_attach_grasps_the_nearest_node_and_detach_releases_it(self):
+        self.set_frame("gripper2", (5.0, 5.0, 5.0))
+        rospy.sleep(0.3)
+        refused = self.attach(frame="gripper2", body="rope", radius=0.05)
+        self.assertFalse(refused.success)
+        self.assertIn("no free node", refused.message)
+        unknown = self.attach(frame="no_such_frame", body="rope", radius=0.05)
+        self.assertFalse(unknown.success)
+        self.assertIn("no transform", unknown.message)
+
+        # Next to node 2, closer than to its neighbours 0.1 m away; paused, so that the rope swinging
+        # below the circling gripper_link does not carry node 2 away meanwhile.
+        pause = rospy.ServiceProxy(NODE + "/pause", SetBool)
+        pause(True)
+        self.state.next(2)
+        x, y, z = self.state.node("rope", 2)
+        self.set_frame("gripper2", (x, y, z + 0.01))
+        rospy.sleep(0.3)
+        grasp = self.attach(frame="gripper2", body="", radius=0.05)
+        pause(False)
+        self.assertTrue(grasp.success, grasp.message)
+        self.assertEqual((grasp.node, grasp.anchor), (2, "gripper2"))
+        again = self.attach(frame="gripper2", body="rope", radius=0.5)
+        self.assertFalse(again.success)
+
+        # The gripper carries the node up and aside.
+        self.set_frame("gripper2", (0.25, 0.2, 1.3))
+        self.assertTrue(wait_for(lambda: math.dist(self.state.node("rope", 2), (0.25, 0.2, 1.3)) < 1e-9, 10.0),
+                        self.state.node("rope", 2))
+        released = self.detach(frame="gripper2")
+        self.assertTrue(released.success, released.message)
+        self.assertFalse(self.detach(frame="gripper2").success)
+        # Free again: it falls back below the gripper.
+        self.assertTrue(wait_for(lambda: self.state.node("rope", 2)[2] < 1.2, 10.0), self.state.node("rope", 2))
+
+
+if __name__ == "__main__":
+    rostest.rosrun("soft_body_sim", "inputs", InputsTest)
