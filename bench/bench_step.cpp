@@ -3,8 +3,14 @@
 // from the scene) as in a minimal loop that knows only springs and gravity. Compare, in one run,
 //   BM_RopeStepEngine/semi_implicit_euler  against  BM_RopeStepMinimalLoop
 // (same rope, same scheme, same arithmetic); their ratio is the price of the unused features.
+// Cloths of 100 to 100,000 nodes (BM_ClothStep/<integrator>/<nodes>) give the cost per spring update
+// (items = spring updates) and how the step cost grows with the node count (scripts/bench fits the
+// log-log slope); BM_ClothSpringForces is the force kernel alone on the 10,000-node cloth.
+#include <cmath>
+
 #include <benchmark/benchmark.h>
 
+#include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/forces.h"
 
@@ -63,6 +69,61 @@ void BM_RopeStepMinimalLoop(benchmark::State& bench)
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.springs.size()));
 }
 
+/// config/scenes/cloth.yaml's cloth with `nodes` nodes (a square grid) of the same node mass and
+/// springs, pinned at two corners, flat and falling: every spring is updated every step.
+SceneDef clothScene(int nodes, IntegratorType integrator)
+{
+  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(nodes))));
+  ClothDef cloth;
+  cloth.nx = cloth.ny = side;
+  cloth.mass = 0.3 / 225.0 * side * side;
+  cloth.structural = SpringParameters{ 1000.0, 0.02 };
+  cloth.shear = SpringParameters{ 200.0, 0.01 };
+  cloth.bending = SpringParameters{ 20.0, 0.0 };
+  cloth.pinned = { 0, side - 1 };
+  SceneDef scene;
+  scene.physics.integrator = integrator;
+  // Stable for the explicit scheme: omega_max ~ 3500 1/s at this node mass.
+  scene.physics.step.dt = 2e-4;
+  scene.bodies.push_back(buildCloth("cloth", cloth));
+  return scene;
+}
+
+void BM_ClothStep(benchmark::State& bench, IntegratorType integrator)
+{
+  World world = buildWorld(clothScene(static_cast<int>(bench.range(0)), integrator));
+  world.step();  // sizes the integrator's arrays
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.counters["nodes"] = world.model().nodeCount();
+  bench.counters["springs"] = static_cast<double>(world.model().springs.size());
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(world.model().springs.size()));
+}
+
+/// The spring force kernel alone: every spring's Hooke + dashpot force, accumulated.
+void BM_ClothSpringForces(benchmark::State& bench)
+{
+  const World world = buildWorld(clothScene(static_cast<int>(bench.range(0)), IntegratorType::SemiImplicitEuler));
+  const Model& model = world.model();
+  NodeArray force = NodeArray::Zero(3, model.nodeCount());
+  for (auto _ : bench)
+  {
+    accumulateSpringForces(model, world.state().position, world.state().velocity, force);
+    benchmark::DoNotOptimize(force.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.springs.size()));
+}
+
+/// Node counts from 100 to 100,000, two per decade.
+void clothSizes(benchmark::internal::Benchmark* bench)
+{
+  for (int nodes : { 100, 316, 1000, 3162, 10000, 31623, 100000 })
+    bench->Arg(nodes);
+}
+
 BENCHMARK(BM_RopeStepMinimalLoop)->Arg(100)->Arg(1000);
 BENCHMARK_CAPTURE(BM_RopeStepEngine, semi_implicit_euler, IntegratorType::SemiImplicitEuler)->Arg(100)->Arg(1000);
 BENCHMARK_CAPTURE(BM_RopeStepEngine, explicit_euler, IntegratorType::ExplicitEuler)->Arg(100)->Arg(1000);
@@ -71,6 +132,10 @@ BENCHMARK_CAPTURE(BM_RopeStepEngine, velocity_verlet, IntegratorType::VelocityVe
 BENCHMARK_CAPTURE(BM_RopeStepEngine, rk4, IntegratorType::Rk4)->Arg(100)->Arg(1000);
 BENCHMARK_CAPTURE(BM_RopeStepEngine, implicit_euler, IntegratorType::ImplicitEuler)->Arg(100)->Arg(1000);
 BENCHMARK_CAPTURE(BM_RopeStepEngine, xpbd, IntegratorType::Xpbd)->Arg(100)->Arg(1000);
+BENCHMARK_CAPTURE(BM_ClothStep, semi_implicit_euler, IntegratorType::SemiImplicitEuler)->Apply(clothSizes);
+BENCHMARK_CAPTURE(BM_ClothStep, xpbd, IntegratorType::Xpbd)->Apply(clothSizes);
+BENCHMARK_CAPTURE(BM_ClothStep, implicit_euler, IntegratorType::ImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000);
+BENCHMARK(BM_ClothSpringForces)->Arg(10000);
 
 }  // namespace
 }  // namespace soft_body_sim

@@ -12,13 +12,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
 {
   using namespace soft_body_sim;
   const std::string text(reinterpret_cast<const char*>(data), size);
-  // Counts of 1000 and more (nx: 1000, nodes: 99999) make legitimately large scenes of up to 10^6
-  // nodes, which test_hard_cases covers; here they would only spend the run on allocation. Such an
-  // integer is a run of 4+ digits not followed by '.', 'e' or 'E' (a float such as 8000.0 passes).
+  // Counts of 100 and more (nx: 999, ny: 999) make legitimately large scenes of up to 10^6 nodes,
+  // which test_hard_cases covers; here they would only spend the run on allocation. Such an integer is
+  // a run of 3+ digits not followed by '.', 'e' or 'E' (a float such as 8000.0 passes).
   for (std::size_t i = 0, run = 0; i <= text.size(); ++i)
   {
     const bool digit = i < text.size() && text[i] >= '0' && text[i] <= '9';
-    if (!digit && run >= 4 && (i == text.size() || (text[i] != '.' && text[i] != 'e' && text[i] != 'E')))
+    if (!digit && run >= 3 && (i == text.size() || (text[i] != '.' && text[i] != 'e' && text[i] != 'E')))
       return 0;
     run = digit ? run + 1 : 0;
   }

@@ -26,6 +26,9 @@ PACKAGES=(
 )
 # What only the demo needs on top: rviz (already in PACKAGES for the rviz screenshot test).
 DEMO_PACKAGES=(rviz)
+# What only scripts/bench needs on top: Bullet (the peer; Debian builds it in double precision too, as
+# pkg-config bullet-float64), pkg-config to find it, matplotlib for the plots.
+BENCH_PACKAGES=(libbullet-dev pkg-config python3-matplotlib)
 
 log() { printf '[%s] %s\n' "$(basename "$0")" "$*" >&2; }
 

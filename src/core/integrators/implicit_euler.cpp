@@ -1,5 +1,8 @@
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/SparseCore>
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+#include <Eigen/LU>
 
 #include "integrator_kit.h"
 #include "soft_body_sim/core/forces.h"
@@ -14,7 +17,7 @@ using Matrix3 = Eigen::Matrix3d;
 /// solved by Newton's method as in Baraff & Witkin 1998 ("Large steps in cloth simulation"):
 /// each iteration linearises f about (x_lin, v_k) and solves
 ///   (M - h D - h^2 K) dv = h f(x_lin, v_k) + h K (x_n + h v_k - x_lin) - M (v_k - v_n)
-/// with K = df/dx, D = df/dv, by sparse conjugate gradients. The first iteration linearises at
+/// with K = df/dx, D = df/dv, by preconditioned conjugate gradients. The first iteration linearises at
 /// x_lin = x_n (exactly Baraff & Witkin's step); later ones at x_lin = x_n + h v_k.
 /// K's transverse term k (1 - L/l)(I - u u^T) is dropped when the spring is compressed (Choi & Ko
 /// 2002) so that the matrix stays symmetric positive definite; the damping force's dependence on x is
@@ -23,13 +26,14 @@ using Matrix3 = Eigen::Matrix3d;
 ///   K_kl = -(d^2E/dA^2) dA/dx_k dA/dx_l^T,
 /// dropping p d^2A/dx_k dx_l, which is indefinite (A is bilinear in the positions) and vanishes at
 /// rest; the kept part is the one that stiffens without bound as the cell is squeezed.
+///
+/// The matrix is never assembled: a spring's 3x3 block is a u u^T + b I (below), so the product
+/// A p is one pass over the nodes' diagonal blocks, one over the springs and one over the cells, with
+/// no sparse index structure to build, and every array is sized once: a step allocates nothing after
+/// the first.
 class ImplicitEuler final : public Integrator
 {
 public:
-  /// CG stops at a relative residual of 1e-12: far below the scheme's O(h) error, and without it
-  /// Eigen iterates to machine precision (up to 2n sweeps).
-  ImplicitEuler() { solver_.setTolerance(1e-12); }
-
   void step(const Model& model, State& state, double h, int iterations) override
   {
     const int n = model.nodeCount();
@@ -51,11 +55,10 @@ public:
           linear_x_.col(i) += h * v_k.col(i);
       }
       assemble(model, linear_x_, v_k, h);
-      solver_.compute(matrix_);
-      delta_v_ = solver_.solve(rhs_);
+      solve(model);
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
-          state.velocity.col(i) += delta_v_.segment<3>(3 * i);
+          state.velocity.col(i) += delta_v_.col(i);
     }
     for (int i = 0; i < n; ++i)
       if (model.isFree(i))
@@ -64,7 +67,24 @@ public:
   }
 
 private:
-  /// Fills matrix_ = M - h D - h^2 K and rhs_ (see the class comment) at (x, v).
+  /// A spring's block of M - h D - h^2 K: h^2 k (u u^T + t (I - u u^T)) + h c u u^T = a u u^T + b I,
+  /// on the diagonal at both ends and negated off the diagonal.
+  struct SpringBlock
+  {
+    Vec3 u;
+    double a;
+    double b;
+    bool coupled;  ///< both ends free: the off-diagonal blocks are in the matrix
+  };
+
+  /// A cell's blocks h^2 S g_k g_l^T (g_k = dA/dx_k of its free corners, zero for pinned ones).
+  struct CellBlock
+  {
+    Vec3 g[4];
+    double scale;  ///< h^2 S [N/m^3 s^2]
+  };
+
+  /// Fills the blocks of A = M - h D - h^2 K and rhs_ (see the class comment) at (x, v).
   void assemble(const Model& model, const NodeArray& x, const NodeArray& v, double h)
   {
     const int n = model.nodeCount();
@@ -72,91 +92,176 @@ private:
     accumulateSpringForces(model, x, v, force_);
     if (!model.cells.empty())
       accumulatePressureForces(model, x, force_);
-    triplets_.clear();
-    rhs_.resize(3 * n);
+    rhs_.resize(3, n);
+    diagonal_.resize(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i)
     {
+      Matrix3& d = diagonal_[static_cast<std::size_t>(i)];
       if (!model.isFree(i))
       {
         // Pinned: dv = 0, an identity row.
-        rhs_.segment<3>(3 * i).setZero();
-        addBlock(i, i, Matrix3::Identity());
+        rhs_.col(i).setZero();
+        d.setIdentity();
         continue;
       }
       const double m = model.mass[i];
       const Vec3 f = force_.col(i) + m * model.gravity - m * model.drag * v.col(i);
-      rhs_.segment<3>(3 * i) = h * f - m * (v.col(i) - start_v_.col(i));
-      addBlock(i, i, (m * (1.0 + h * model.drag)) * Matrix3::Identity());
+      rhs_.col(i) = h * f - m * (v.col(i) - start_v_.col(i));
+      d = (m * (1.0 + h * model.drag)) * Matrix3::Identity();
     }
-    for (const Spring& s : model.springs)
+    springs_.resize(model.springs.size());
+    for (std::size_t k = 0; k < model.springs.size(); ++k)
     {
-      Vec3 u;
+      const Spring& s = model.springs[k];
+      SpringBlock& block = springs_[k];
       double length;
-      if (!springAxis(x, s.a, s.b, u, length))
+      if (!springAxis(x, s.a, s.b, block.u, length))
+      {
+        block = SpringBlock{ Vec3::Zero(), 0.0, 0.0, false };
         continue;
-      const Matrix3 uu = u * u.transpose();
+      }
+      const Matrix3 uu = block.u * block.u.transpose();
       const double transverse = std::max(0.0, 1.0 - s.rest_length / length);
       // -df_a/dx_a of the spring (clamped, see above) and -df_a/dv_a of its dashpot.
       const Matrix3 stiffness = s.stiffness * (uu + transverse * (Matrix3::Identity() - uu));
-      const Matrix3 block = h * h * stiffness + h * s.damping * uu;
+      block.a = h * h * s.stiffness * (1.0 - transverse) + h * s.damping;
+      block.b = h * h * s.stiffness * transverse;
+      const Matrix3 diagonal = h * h * stiffness + h * s.damping * uu;
       const Vec3 k_offset = -stiffness * (offset_.col(s.a) - offset_.col(s.b));
       const bool a_free = model.isFree(s.a);
       const bool b_free = model.isFree(s.b);
       if (a_free)
       {
-        rhs_.segment<3>(3 * s.a) += h * k_offset;
-        addBlock(s.a, s.a, block);
+        rhs_.col(s.a) += h * k_offset;
+        diagonal_[static_cast<std::size_t>(s.a)] += diagonal;
       }
       if (b_free)
       {
-        rhs_.segment<3>(3 * s.b) -= h * k_offset;
-        addBlock(s.b, s.b, block);
+        rhs_.col(s.b) -= h * k_offset;
+        diagonal_[static_cast<std::size_t>(s.b)] += diagonal;
       }
-      if (a_free && b_free)
-      {
-        addBlock(s.a, s.b, -block);
-        addBlock(s.b, s.a, -block);
-      }
+      block.coupled = a_free && b_free;
     }
-    for (const PressureCell& cell : model.cells)
-      addCell(model, cell, x, h);
-    matrix_.resize(3 * n, 3 * n);
-    matrix_.setFromTriplets(triplets_.begin(), triplets_.end());
+    cells_.resize(model.cells.size());
+    preconditioner_.resize(static_cast<std::size_t>(n));
+    for (int i = 0; i < n; ++i)
+      preconditioner_[static_cast<std::size_t>(i)] = diagonal_[static_cast<std::size_t>(i)];
+    for (std::size_t k = 0; k < model.cells.size(); ++k)
+      addCell(model, model.cells[k], x, h, cells_[k]);
+    // Block Jacobi: the inverse of each node's 3x3 diagonal block (SPD, so invertible).
+    for (int i = 0; i < n; ++i)
+    {
+      Matrix3& p = preconditioner_[static_cast<std::size_t>(i)];
+      p = p.inverse().eval();
+    }
   }
 
-  /// The cell's share of matrix_ (h^2 S g_k g_l^T, S = d^2E/dA^2, g_k = dA/dx_k) and of rhs_
-  /// (h K offset, with (K offset)_k = -S g_k sum_l g_l . offset_l) on its free corners.
-  void addCell(const Model& model, const PressureCell& cell, const NodeArray& x, double h)
+  /// The cell's share of rhs_ (h K offset, with (K offset)_k = -S g_k sum_l g_l . offset_l) on its
+  /// free corners, its blocks for the product and its diagonal blocks for the preconditioner.
+  void addCell(const Model& model, const PressureCell& cell, const NodeArray& x, double h, CellBlock& block)
   {
-    Vec3 g[4];
-    const double stiffness = cellGas(cell, cellArea(cell, x, g)).stiffness;
+    const double stiffness = cellGas(cell, cellArea(cell, x, block.g)).stiffness;
     double g_dot_offset = 0.0;
     for (int k = 0; k < 4; ++k)
-      g_dot_offset += g[k].dot(offset_.col(cell.nodes[k]));
+      g_dot_offset += block.g[k].dot(offset_.col(cell.nodes[k]));
+    block.scale = h * h * stiffness;
     for (int k = 0; k < 4; ++k)
     {
       const int row = cell.nodes[k];
       if (!model.isFree(row))
+      {
+        block.g[k].setZero();
         continue;
-      rhs_.segment<3>(3 * row) -= (h * stiffness * g_dot_offset) * g[k];
-      for (int l = 0; l < 4; ++l)
-        if (model.isFree(cell.nodes[l]))
-          addBlock(row, cell.nodes[l], (h * h * stiffness) * g[k] * g[l].transpose());
+      }
+      rhs_.col(row) -= (h * stiffness * g_dot_offset) * block.g[k];
+      preconditioner_[static_cast<std::size_t>(row)] += block.scale * block.g[k] * block.g[k].transpose();
     }
   }
 
-  void addBlock(int row, int col, const Matrix3& block)
+  /// out = A p.
+  void multiply(const Model& model, const NodeArray& p, NodeArray& out) const
   {
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c)
-        triplets_.emplace_back(3 * row + r, 3 * col + c, block(r, c));
+    const int n = model.nodeCount();
+    for (int i = 0; i < n; ++i)
+      out.col(i) = diagonal_[static_cast<std::size_t>(i)] * p.col(i);
+    for (std::size_t k = 0; k < springs_.size(); ++k)
+    {
+      const SpringBlock& block = springs_[k];
+      if (!block.coupled)
+        continue;
+      const Spring& s = model.springs[k];
+      const Vec3 p_a = p.col(s.a);
+      const Vec3 p_b = p.col(s.b);
+      out.col(s.a) -= block.a * block.u.dot(p_b) * block.u + block.b * p_b;
+      out.col(s.b) -= block.a * block.u.dot(p_a) * block.u + block.b * p_a;
+    }
+    for (std::size_t k = 0; k < cells_.size(); ++k)
+    {
+      const CellBlock& block = cells_[k];
+      const PressureCell& cell = model.cells[k];
+      double g_dot_p = 0.0;
+      for (int l = 0; l < 4; ++l)
+        g_dot_p += block.g[l].dot(p.col(cell.nodes[l]));
+      for (int l = 0; l < 4; ++l)
+        out.col(cell.nodes[l]) += (block.scale * g_dot_p) * block.g[l];
+    }
   }
 
+  void precondition(const NodeArray& r, NodeArray& z) const
+  {
+    for (Eigen::Index i = 0; i < r.cols(); ++i)
+      z.col(i) = preconditioner_[static_cast<std::size_t>(i)] * r.col(i);
+  }
+
+  static double dot(const NodeArray& a, const NodeArray& b) { return a.cwiseProduct(b).sum(); }
+
+  /// delta_v_ = A^-1 rhs_ by preconditioned conjugate gradients from 0, stopped at a relative residual
+  /// of kTolerance or after 2 * 3n iterations (the algorithm and the stopping rule of Eigen's
+  /// ConjugateGradient, which this replaces).
+  void solve(const Model& model)
+  {
+    const Eigen::Index n = rhs_.cols();
+    delta_v_.setZero(3, n);
+    residual_ = rhs_;
+    const double rhs_norm2 = rhs_.squaredNorm();
+    if (rhs_norm2 == 0.0)
+      return;
+    const double threshold = std::max(kTolerance * kTolerance * rhs_norm2, std::numeric_limits<double>::min());
+    double residual_norm2 = rhs_norm2;
+    if (residual_norm2 < threshold)
+      return;  // rhs so small (near underflow) that any iteration would divide by zero
+    direction_.resize(3, n);
+    z_.resize(3, n);
+    product_.resize(3, n);
+    precondition(residual_, direction_);
+    double r_dot_z = dot(residual_, direction_);
+    const Eigen::Index max_iterations = 2 * 3 * n;
+    for (Eigen::Index iteration = 0; iteration < max_iterations; ++iteration)
+    {
+      multiply(model, direction_, product_);
+      const double alpha = r_dot_z / dot(direction_, product_);
+      delta_v_ += alpha * direction_;
+      residual_ -= alpha * product_;
+      residual_norm2 = residual_.squaredNorm();
+      if (residual_norm2 < threshold)
+        break;
+      precondition(residual_, z_);
+      const double previous_r_dot_z = r_dot_z;
+      r_dot_z = dot(residual_, z_);
+      direction_ = z_ + (r_dot_z / previous_r_dot_z) * direction_;
+    }
+  }
+
+  /// CG stops at a relative residual of 1e-12: far below the scheme's O(h) error; without it CG would
+  /// iterate to machine precision (up to 6n sweeps).
+  static constexpr double kTolerance = 1e-12;
+
   NodeArray start_x_, start_v_, linear_x_, offset_, force_;
-  std::vector<Eigen::Triplet<double>> triplets_;
-  Eigen::SparseMatrix<double> matrix_;
-  Eigen::VectorXd rhs_, delta_v_;
-  Eigen::ConjugateGradient<Eigen::SparseMatrix<double>, Eigen::Lower | Eigen::Upper> solver_;
+  NodeArray rhs_, delta_v_, residual_, direction_, z_, product_;
+  std::vector<Matrix3> diagonal_;        ///< per node: mass and spring blocks of A
+  std::vector<Matrix3> preconditioner_;  ///< per node: the inverse of A's full diagonal block
+  std::vector<SpringBlock> springs_;
+  std::vector<CellBlock> cells_;
   ConstraintPass constraints_;
 };
 }  // namespace

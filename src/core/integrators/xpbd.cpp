@@ -1,3 +1,7 @@
+#include <cstdint>
+#include <utility>
+#include <vector>
+
 #include "integrator_kit.h"
 #include "soft_body_sim/core/forces.h"
 
@@ -54,13 +58,18 @@ public:
     postSolve(model, state, h);
   }
 
+  /// The world calls this after changing the model (stiffness, masses, an attached node) as well as
+  /// the state: rebuild the rows at the next sweep.
+  void invalidate() override { rows_h_ = 0.0; }
+
 private:
   void preSolve(const Model& model, State& state, double h)
   {
-    previous_ = state.position;
+    previous_.resize(3, model.nodeCount());  // no allocation after the first sub-step
     const double drag_factor = 1.0 / (1.0 + h * model.drag);
     for (int i = 0; i < model.nodeCount(); ++i)
     {
+      previous_.col(i) = state.position.col(i);
       if (!model.isFree(i))
         continue;
       state.velocity.col(i) = state.velocity.col(i) * drag_factor + h * model.gravity;
@@ -70,35 +79,107 @@ private:
 
   void solve(const Model& model, NodeArray& x, double h, int iterations)
   {
-    const double inverse_h2 = 1.0 / (h * h);
-    rows_.clear();
-    for (const Spring& s : model.springs)
+    const std::size_t spring_count = model.springs.size();
+    const std::size_t row_count = spring_count + model.constraints.size();
+    if (order_.size() != row_count || coloured_nodes_ != model.nodeCount())
     {
-      const double alpha_tilde = inverse_h2 / s.stiffness;
-      rows_.push_back({ s.a, s.b, s.rest_length, alpha_tilde, alpha_tilde * s.damping * h });
+      colourRows(model);
+      rows_h_ = 0.0;
     }
-    for (const DistanceConstraint& c : model.constraints)
-      rows_.push_back({ c.a, c.b, c.rest_length, c.compliance * inverse_h2, 0.0 });
-    lambda_.setZero(static_cast<Eigen::Index>(rows_.size()));
+    rows_.resize(row_count);  // sized once: no allocation after the first sub-step
+    lambda_.setZero(static_cast<Eigen::Index>(row_count));
     cell_lambda_.setZero(static_cast<Eigen::Index>(model.cells.size()));
     for (int iteration = 0; iteration < iterations; ++iteration)
     {
-      for (std::size_t k = 0; k < rows_.size(); ++k)
-        solveDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
+      if (iteration == 0 && h != rows_h_)
+      {
+        // Rows are stale (new h, or invalidate(): the model may have been retuned): the first sweep
+        // writes them as it goes.
+        const double inverse_h2 = 1.0 / (h * h);
+        for (std::size_t k = 0; k < row_count; ++k)
+        {
+          const std::size_t r = order_[k];
+          ConstraintRow row;
+          if (r < spring_count)
+          {
+            const Spring& s = model.springs[r];
+            const double alpha_tilde = inverse_h2 / s.stiffness;
+            row = ConstraintRow{ s.a, s.b, s.rest_length, alpha_tilde, alpha_tilde * s.damping * h };
+          }
+          else
+          {
+            const DistanceConstraint& c = model.constraints[r - spring_count];
+            row = ConstraintRow{ c.a, c.b, c.rest_length, c.compliance * inverse_h2, 0.0 };
+          }
+          rows_[k] = sweepRow(row, model.inverse_mass);
+          projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
+        }
+        rows_h_ = h;
+      }
+      else
+      {
+        for (std::size_t k = 0; k < row_count; ++k)
+          projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
+      }
       for (std::size_t k = 0; k < model.cells.size(); ++k)
         solveCell(model.cells[k], model.inverse_mass, h, x, cell_lambda_[static_cast<Eigen::Index>(k)]);
     }
   }
 
+  /// The sweep order: springs and constraints (row r < springs.size() is spring r, the others the
+  /// constraints in turn) grouped by a greedy edge colouring, so that no two rows of a colour share a
+  /// node. In model order, consecutive rows of a rope or a cloth row share a node, so each update waits
+  /// for its predecessor's square root and divisions (~90 cycles); within a colour the processor
+  /// overlaps them. Gauss-Seidel in this order converges as fast as in model order (both are
+  /// consistent orderings; for a chain, red-black and lexicographic have the same spectral radius).
+  void colourRows(const Model& model)
+  {
+    const std::size_t spring_count = model.springs.size();
+    const std::size_t row_count = spring_count + model.constraints.size();
+    const auto ends = [&](std::size_t r) {
+      return r < spring_count ? std::pair<int, int>(model.springs[r].a, model.springs[r].b)
+                              : std::pair<int, int>(model.constraints[r - spring_count].a,
+                                                    model.constraints[r - spring_count].b);
+    };
+    constexpr int kColours = 64;
+    std::vector<std::uint64_t> used(static_cast<std::size_t>(model.nodeCount()), 0);
+    std::vector<std::uint8_t> colour(row_count);
+    std::size_t start[kColours + 1] = {};
+    for (std::size_t r = 0; r < row_count; ++r)
+    {
+      const auto [a, b] = ends(r);
+      const std::uint64_t taken = used[static_cast<std::size_t>(a)] | used[static_cast<std::size_t>(b)];
+      // The first free colour; a node with 64 rows shares the last one (still correct, only slower).
+      int c = 0;
+      while (c < kColours - 1 && (taken >> c) & 1u)
+        ++c;
+      colour[r] = static_cast<std::uint8_t>(c);
+      used[static_cast<std::size_t>(a)] |= std::uint64_t{ 1 } << c;
+      used[static_cast<std::size_t>(b)] |= std::uint64_t{ 1 } << c;
+      ++start[c + 1];
+    }
+    for (int c = 0; c < kColours; ++c)
+      start[c + 1] += start[c];
+    order_.resize(row_count);
+    for (std::size_t r = 0; r < row_count; ++r)
+      order_[start[colour[r]]++] = static_cast<std::uint32_t>(r);
+    coloured_nodes_ = model.nodeCount();
+  }
+
   void postSolve(const Model& model, State& state, double h)
   {
+    // One division per sub-step, not three per node.
+    const double inverse_h = 1.0 / h;
     for (int i = 0; i < model.nodeCount(); ++i)
       if (model.isFree(i))
-        state.velocity.col(i) = (state.position.col(i) - previous_.col(i)) / h;
+        state.velocity.col(i) = (state.position.col(i) - previous_.col(i)) * inverse_h;
   }
 
   NodeArray previous_;
-  std::vector<ConstraintRow> rows_;
+  std::vector<std::uint32_t> order_;  ///< sweep order of the rows (see colourRows)
+  int coloured_nodes_ = -1;
+  std::vector<SweepRow> rows_;        ///< the rows in sweep order, valid for h = rows_h_
+  double rows_h_ = 0.0;               ///< [s]; 0 = rows not built
   Eigen::VectorXd lambda_;
   Eigen::VectorXd cell_lambda_;
 };

@@ -1,0 +1,87 @@
+// The work-precision benchmark's view of a simulation: something that advances by one step and shows
+// its node positions, whichever engine runs it (this package's World, or Bullet's soft bodies).
+#pragma once
+
+#include <ctime>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "soft_body_sim/core/scene_def.h"
+
+namespace soft_body_sim::bench
+{
+/// CPU time [s] of the calling thread: what a step costs, whatever else the machine runs.
+inline double cpuSeconds()
+{
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+/// How a run is stepped: an integrator of this package (or "bullet"), the step dt [s], sub-steps per
+/// step and iterations (for Bullet: its position-solver iterations, piterations).
+struct Config
+{
+  std::string integrator;
+  double dt = 0.01;
+  int substeps = 1;
+  int iterations = 1;
+};
+
+class Engine
+{
+public:
+  virtual ~Engine() = default;
+  /// Advances by one step dt.
+  virtual void step() = 0;
+  /// Node positions [m], one column per node, in the problem's node order.
+  virtual const Eigen::Matrix3Xd& positions() = 0;
+  /// Total energy [J] (kinetic + elastic + gravitational), NaN where the engine does not say.
+  virtual double energy() { return std::numeric_limits<double>::quiet_NaN(); }
+  /// Deepest any node has been behind a plane [m] so far, seen inside the step (before the contact
+  /// pass pushes it out); 0 where not observed.
+  virtual double penetration() { return 0.0; }
+};
+
+/// This package: World::step, exactly as a user runs it.
+class PackageEngine final : public Engine
+{
+public:
+  explicit PackageEngine(const SceneDef& scene) : world_(buildWorld(scene)) {}
+  void step() override { world_.step(); }
+  const Eigen::Matrix3Xd& positions() override { return world_.state().position; }
+  double energy() override { return world_.energy(); }
+  const World& world() const { return world_; }
+
+private:
+  World world_;
+};
+
+/// The stages of World::step for a scene without anchors or controllers (integrator, then planes, per
+/// sub-step), run by hand so that the depth of a node behind a plane can be read between the two: the
+/// contact pass leaves every node on or above its plane, so after a step the penetration is always 0.
+/// checkAgainstWorld() confirms that it steps bit-identically to World.
+class ProbeEngine final : public Engine
+{
+public:
+  explicit ProbeEngine(const SceneDef& scene);
+  void step() override;
+  const Eigen::Matrix3Xd& positions() override { return state_.position; }
+  double energy() override;
+  double penetration() override { return penetration_; }
+
+  /// True if `steps` steps of this engine and of World give bit-identical positions.
+  static bool checkAgainstWorld(const SceneDef& scene, int steps);
+
+private:
+  Model model_;
+  State state_;
+  StepSettings settings_;
+  std::unique_ptr<Integrator> integrator_;
+  std::vector<std::uint8_t> touching_;
+  double penetration_ = 0.0;
+};
+
+}  // namespace soft_body_sim::bench

@@ -1,0 +1,213 @@
+// A physics step allocates no memory after the first one: every integrator, in a scene with every
+// feature a step touches (springs, distance constraints, gas cells, a floor, moving anchors, and the
+// creature, limb and humanoid controllers).
+// Allocations are counted by interposing the C allocator: operator new (libstdc++) and Eigen's
+// aligned_malloc both end in malloc, so counting malloc, calloc, realloc and the aligned variants
+// sees every heap allocation of the step, whoever makes it.
+#include <cstddef>
+#include <cstdlib>
+
+#include <gtest/gtest.h>
+
+#include "soft_body_sim/core/bodies/cloth.h"
+#include "soft_body_sim/core/bodies/creature.h"
+#include "soft_body_sim/core/bodies/humanoid.h"
+#include "soft_body_sim/core/bodies/jelly.h"
+#include "soft_body_sim/core/bodies/limb.h"
+#include "soft_body_sim/core/bodies/rope.h"
+#include "soft_body_sim/core/scene_def.h"
+
+// glibc's own entry points, which the interposed functions below forward to.
+extern "C" void* __libc_malloc(std::size_t size);
+extern "C" void* __libc_calloc(std::size_t count, std::size_t size);
+extern "C" void* __libc_realloc(void* pointer, std::size_t size);
+extern "C" void* __libc_memalign(std::size_t alignment, std::size_t size);
+extern "C" void __libc_free(void* pointer);
+
+namespace
+{
+bool g_counting = false;
+long g_allocations = 0;
+void* volatile g_sink = nullptr;  // keeps the probe allocations below from being optimised away
+
+void count()
+{
+  if (g_counting)
+    ++g_allocations;
+}
+}  // namespace
+
+extern "C"
+{
+void* malloc(std::size_t size)
+{
+  count();
+  return __libc_malloc(size);
+}
+void* calloc(std::size_t count_, std::size_t size)
+{
+  count();
+  return __libc_calloc(count_, size);
+}
+void* realloc(void* pointer, std::size_t size)
+{
+  count();
+  return __libc_realloc(pointer, size);
+}
+void* memalign(std::size_t alignment, std::size_t size)
+{
+  count();
+  return __libc_memalign(alignment, size);
+}
+void* aligned_alloc(std::size_t alignment, std::size_t size)
+{
+  count();
+  return __libc_memalign(alignment, size);
+}
+int posix_memalign(void** pointer, std::size_t alignment, std::size_t size)
+{
+  count();
+  *pointer = __libc_memalign(alignment, size);
+  return *pointer ? 0 : 12;  // ENOMEM
+}
+void free(void* pointer) { __libc_free(pointer); }
+}
+
+namespace soft_body_sim::test
+{
+namespace
+{
+/// Allocations made by `action`.
+template <typename Action>
+long allocationsOf(Action&& action)
+{
+  g_allocations = 0;
+  g_counting = true;
+  action();
+  g_counting = false;
+  return g_allocations;
+}
+
+/// Every body type side by side above a floor, with anchors on the rope and the cloth and inextensible
+/// constraints along the rope, so that a step runs every stage and every kernel.
+SceneDef everyFeatureScene(IntegratorType integrator)
+{
+  SceneDef scene;
+  scene.physics.integrator = integrator;
+  // Explicit Euler gains energy every step: a small step keeps it finite over the test.
+  scene.physics.step.dt = integrator == IntegratorType::ExplicitEuler ? 1e-4 : 2e-3;
+  scene.physics.step.substeps = 2;
+  scene.physics.step.iterations = 2;
+  scene.physics.drag = 0.1;
+  scene.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.2, 0.5 } };
+
+  RopeDef rope;
+  rope.nodes = 12;
+  rope.from = Vec3(-2.0, 0.0, 1.0);
+  rope.to = Vec3(-1.0, 0.0, 1.0);
+  rope.stiffness = 500.0;
+  rope.damping = 0.01;
+  rope.bending = 10.0;
+  rope.pinned = { 0, -1 };
+  BodyDef rope_body = buildRope("rope", rope);
+  for (int i = 0; i + 1 < rope.nodes; ++i)
+    rope_body.constraints.push_back(ConstraintDef{ i, i + 1, 1e-4, std::nullopt });
+  rope_body.anchors = { AnchorDef{ "left", 0 }, AnchorDef{ "right", rope.nodes - 1 } };
+  scene.bodies.push_back(rope_body);
+
+  ClothDef cloth;
+  cloth.nx = 6;
+  cloth.ny = 5;
+  cloth.corners = GridCorners{ Vec3(0.0, 0.0, 1.0), Vec3(0.5, 0.0, 1.0), Vec3(0.0, 0.5, 1.0) };
+  cloth.bending = SpringParameters{ 5.0, 0.0 };
+  cloth.pinned = { 0 };
+  BodyDef cloth_body = buildCloth("cloth", cloth);
+  cloth_body.anchors = { AnchorDef{ "corner", 0 } };
+  scene.bodies.push_back(cloth_body);
+
+  JellyDef jelly;
+  jelly.nx = 3;
+  jelly.ny = 3;
+  // 1 mm above the floor: it lands within 15 ms.
+  jelly.corners = GridCorners{ Vec3(1.0, 0.0, 0.301), Vec3(1.3, 0.0, 0.301), Vec3(1.0, 0.0, 0.001) };
+  scene.bodies.push_back(buildJelly("jelly", jelly));
+
+  CreatureDef creature;
+  creature.position = Vec3(3.0, 0.0, 1.0);
+  creature.target = Vec3(3.3, 0.1, 1.0);
+  creature.tendrils = TendrilDef{};
+  scene.bodies.push_back(buildCreature("creature", creature));
+
+  LimbDef limb;
+  limb.root = Vec3(4.0, 0.0, 1.5);
+  limb.direction = Vec3::UnitX();
+  scene.bodies.push_back(buildLimb("limb", limb));
+
+  HumanoidDef humanoid;
+  humanoid.position = Vec3(5.0, 0.0, 1.0);
+  humanoid.target = Vec3(6.0, 0.0, 1.0);
+  scene.bodies.push_back(buildHumanoid("figure", humanoid));
+  return scene;
+}
+
+class StepAllocation : public ::testing::TestWithParam<IntegratorType>
+{
+};
+
+TEST_P(StepAllocation, NoStepAllocatesAfterTheFirst)
+{
+  World world = buildWorld(everyFeatureScene(GetParam()));
+  const int left = *world.findAnchor("rope", "left");
+  const int corner = *world.findAnchor("cloth", "corner");
+  world.step();  // the first step may size the integrator's scratch arrays
+  // Moving anchors invalidate the integrator every sub-step; the jelly lands on the floor early on, so
+  // contacts invalidate it too.
+  const long allocations = allocationsOf([&] {
+    for (int n = 0; n < 400; ++n)
+    {
+      if (n % 10 == 0)
+      {
+        world.moveAnchor(left, Vec3(-2.0, 0.001 * n, 1.0));
+        world.moveAnchor(corner, Vec3(0.0, -0.001 * n, 1.0));
+        world.setTarget("creature", Vec3(3.0 + 0.001 * n, 0.2, 1.0));
+      }
+      world.step();
+    }
+  });
+  EXPECT_EQ(allocations, 0) << integratorName(GetParam());
+  EXPECT_TRUE(world.state().position.allFinite());
+}
+
+TEST(StepAllocation, TheCounterSeesOperatorNewAndEigen)
+{
+  // The interposed allocator must see what a step could allocate, or the test above proves nothing.
+  EXPECT_GE(allocationsOf([] {
+              int* p = new int(1);
+              g_sink = p;
+              delete p;
+            }),
+            1);
+  EXPECT_GE(allocationsOf([] {
+              Eigen::Matrix3Xd grown(3, 100);
+              grown.setZero();
+              g_sink = grown.data();
+            }),
+            1);
+  EXPECT_GE(allocationsOf([] {
+              g_sink = std::malloc(16);
+              std::free(g_sink);
+            }),
+            1);
+}
+
+INSTANTIATE_TEST_SUITE_P(EveryIntegrator, StepAllocation,
+                         ::testing::Values(IntegratorType::ExplicitEuler, IntegratorType::SemiImplicitEuler,
+                                           IntegratorType::Verlet, IntegratorType::VelocityVerlet,
+                                           IntegratorType::Rk4, IntegratorType::ImplicitEuler,
+                                           IntegratorType::Xpbd),
+                         [](const ::testing::TestParamInfo<IntegratorType>& info) {
+                           return integratorName(info.param);
+                         });
+
+}  // namespace
+}  // namespace soft_body_sim::test
