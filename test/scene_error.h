@@ -2,6 +2,7 @@
 #pragma once
 
 #include <functional>
+#include <ostream>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,32 @@ inline void expectSceneError(const std::string& yaml, const std::string& locatio
                              const std::vector<std::string>& reason_words)
 {
   expectSceneError([&] { parseScene(yaml, "bad.yaml"); }, yaml, location, reason_words);
+}
+
+/// One row of a table of bad keys for a generated body type: `keys` (the body's keys from line 4 on)
+/// must be rejected with a message starting "<location>: " that contains every word of `reason_words`.
+struct BadKeys
+{
+  const char* name;  ///< the test's name: says what is wrong
+  std::string keys;
+  const char* location;  ///< "<file>:<line>: <key path>"
+  std::vector<std::string> reason_words;
+};
+
+inline void PrintTo(const BadKeys& bad, std::ostream* out) { *out << bad.name; }
+
+/// `keys` (starting at line 4 of its scene) with line `line` replaced by `text` ("" removes it).
+inline std::string replaceKeyLine(const std::string& keys, int line, const std::string& text)
+{
+  std::string out;
+  int number = 4;
+  for (std::size_t start = 0; start < keys.size(); ++number)
+  {
+    const std::size_t end = keys.find('\n', start) + 1;
+    out += number == line ? (text.empty() ? "" : text + "\n") : keys.substr(start, end - start);
+    start = end;
+  }
+  return out;
 }
 
 }  // namespace soft_body_sim

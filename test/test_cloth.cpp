@@ -270,32 +270,9 @@ TEST(ClothKeys, NoBendingKeyNoBendingSprings)
     EXPECT_FALSE(node.pinned);
 }
 
-struct BadCloth
-{
-  const char* name;
-  std::string keys;
-  const char* location;
-  std::vector<std::string> reason_words;
-};
 
-void PrintTo(const BadCloth& bad, std::ostream* out) { *out << bad.name; }
 
-/// kClothKeys with line `line` (4 = nx ... 11 = shear) replaced by `text` ("" removes it).
-std::string replaceLine(int line, const std::string& text)
-{
-  std::string out;
-  int number = 4;
-  const std::string keys = kClothKeys;
-  for (std::size_t start = 0; start < keys.size(); ++number)
-  {
-    const std::size_t end = keys.find('\n', start) + 1;
-    out += number == line ? (text.empty() ? "" : text + "\n") : keys.substr(start, end - start);
-    start = end;
-  }
-  return out;
-}
-
-class ClothKeysReject : public ::testing::TestWithParam<BadCloth>
+class ClothKeysReject : public ::testing::TestWithParam<BadKeys>
 {
 };
 
@@ -305,28 +282,28 @@ TEST_P(ClothKeysReject, WithOneLineNamingFileLineKeyAndReason)
   expectSceneError([&] { clothScene(bad.keys); }, bad.keys, bad.location, bad.reason_words);
 }
 
-const BadCloth kBadCloths[] = {
-  { "NxIsOne", replaceLine(4, "    nx: 1"), "cloth.yaml:4: bodies[0].nx", { "[2, 1000000]", "got 1" } },
-  { "NxIsAList", replaceLine(4, "    nx: [3]"), "cloth.yaml:4: bodies[0].nx", { "expected an integer", "a list" } },
-  { "NyIsNegative", replaceLine(5, "    ny: -4"), "cloth.yaml:5: bodies[0].ny", { "[2, 1000000]", "-4" } },
-  { "GridTooLarge", replaceLine(4, "    nx: 1000000"), "cloth.yaml:5: bodies[0].ny", { "more than 1000000" } },
-  { "NyMissing", replaceLine(5, ""), "cloth.yaml:2: bodies[0].ny", { "missing required key" } },
-  { "TopLeftIsAWord", replaceLine(6, "    top_left: origin"), "cloth.yaml:6: bodies[0].top_left",
+const BadKeys kBadCloths[] = {
+  { "NxIsOne", replaceKeyLine(kClothKeys, 4, "    nx: 1"), "cloth.yaml:4: bodies[0].nx", { "[2, 1000000]", "got 1" } },
+  { "NxIsAList", replaceKeyLine(kClothKeys, 4, "    nx: [3]"), "cloth.yaml:4: bodies[0].nx", { "expected an integer", "a list" } },
+  { "NyIsNegative", replaceKeyLine(kClothKeys, 5, "    ny: -4"), "cloth.yaml:5: bodies[0].ny", { "[2, 1000000]", "-4" } },
+  { "GridTooLarge", replaceKeyLine(kClothKeys, 4, "    nx: 1000000"), "cloth.yaml:5: bodies[0].ny", { "more than 1000000" } },
+  { "NyMissing", replaceKeyLine(kClothKeys, 5, ""), "cloth.yaml:2: bodies[0].ny", { "missing required key" } },
+  { "TopLeftIsAWord", replaceKeyLine(kClothKeys, 6, "    top_left: origin"), "cloth.yaml:6: bodies[0].top_left",
     { "expected a list of 3 numbers" } },
-  { "CollinearCorners", replaceLine(8, "    bottom_left: [0.4, 0, 1]"), "cloth.yaml:8: bodies[0].bottom_left",
+  { "CollinearCorners", replaceKeyLine(kClothKeys, 8, "    bottom_left: [0.4, 0, 1]"), "cloth.yaml:8: bodies[0].bottom_left",
     { "must span a parallelogram", "collinear" } },
-  { "ZeroMass", replaceLine(9, "    mass: 0"), "cloth.yaml:9: bodies[0].mass", { "must be > 0" } },
-  { "StructuralIsANumber", replaceLine(10, "    structural: 100"), "cloth.yaml:10: bodies[0].structural",
+  { "ZeroMass", replaceKeyLine(kClothKeys, 9, "    mass: 0"), "cloth.yaml:9: bodies[0].mass", { "must be > 0" } },
+  { "StructuralIsANumber", replaceKeyLine(kClothKeys, 10, "    structural: 100"), "cloth.yaml:10: bodies[0].structural",
     { "expected a mapping", "'100'" } },
-  { "StructuralWithoutStiffness", replaceLine(10, "    structural: {damping: 0.1}"),
+  { "StructuralWithoutStiffness", replaceKeyLine(kClothKeys, 10, "    structural: {damping: 0.1}"),
     "cloth.yaml:10: bodies[0].structural.stiffness", { "missing required key" } },
-  { "NegativeStructuralStiffness", replaceLine(10, "    structural: {stiffness: -100}"),
+  { "NegativeStructuralStiffness", replaceKeyLine(kClothKeys, 10, "    structural: {stiffness: -100}"),
     "cloth.yaml:10: bodies[0].structural.stiffness", { "must be > 0", "-100" } },
-  { "UnknownSpringKey", replaceLine(11, "    shear: {stiffness: 20, k: 3}"), "cloth.yaml:11: bodies[0].shear.k",
+  { "UnknownSpringKey", replaceKeyLine(kClothKeys, 11, "    shear: {stiffness: 20, k: 3}"), "cloth.yaml:11: bodies[0].shear.k",
     { "unknown key 'k'", "stiffness, damping" } },
-  { "NegativeShearDamping", replaceLine(11, "    shear: {stiffness: 20, damping: -1}"),
+  { "NegativeShearDamping", replaceKeyLine(kClothKeys, 11, "    shear: {stiffness: 20, damping: -1}"),
     "cloth.yaml:11: bodies[0].shear.damping", { "must be >= 0" } },
-  { "ShearMissing", replaceLine(11, ""), "cloth.yaml:2: bodies[0].shear", { "missing required key" } },
+  { "ShearMissing", replaceKeyLine(kClothKeys, 11, ""), "cloth.yaml:2: bodies[0].shear", { "missing required key" } },
   { "BendingWithZeroStiffness", std::string(kClothKeys) + "    bending: {stiffness: 0}\n",
     "cloth.yaml:12: bodies[0].bending.stiffness", { "must be > 0" } },
   { "UnknownCornerName", std::string(kClothKeys) + "    pinned: [top_left, top_middle]\n",

@@ -778,32 +778,9 @@ TEST(JellyKeys, EveryKeyIsRead)
   EXPECT_EQ(body.cells[0].pressure, 300.0);
 }
 
-struct BadJelly
-{
-  const char* name;
-  std::string keys;
-  const char* location;
-  std::vector<std::string> reason_words;
-};
 
-void PrintTo(const BadJelly& bad, std::ostream* out) { *out << bad.name; }
 
-/// kJellyKeys with line `line` (4 = nx ... 12 = pressure) replaced by `text` ("" removes it).
-std::string jellyLine(int line, const std::string& text)
-{
-  std::string out;
-  int number = 4;
-  const std::string keys = kJellyKeys;
-  for (std::size_t start = 0; start < keys.size(); ++number)
-  {
-    const std::size_t end = keys.find('\n', start) + 1;
-    out += number == line ? (text.empty() ? "" : text + "\n") : keys.substr(start, end - start);
-    start = end;
-  }
-  return out;
-}
-
-class JellyKeysReject : public ::testing::TestWithParam<BadJelly>
+class JellyKeysReject : public ::testing::TestWithParam<BadKeys>
 {
 };
 
@@ -813,25 +790,25 @@ TEST_P(JellyKeysReject, WithOneLineNamingFileLineKeyAndReason)
   expectSceneError([&] { jellyScene(bad.keys); }, bad.keys, bad.location, bad.reason_words);
 }
 
-const BadJelly kBadJellies[] = {
-  { "NoCells", jellyLine(4, "    nx: 0"), "jelly.yaml:4: bodies[0].nx", { "[1, 1000000]", "got 0" } },
-  { "NyIsAWord", jellyLine(5, "    ny: three"), "jelly.yaml:5: bodies[0].ny", { "expected an integer", "'three'" } },
-  { "GridTooLarge", jellyLine(5, "    ny: 999999"), "jelly.yaml:5: bodies[0].ny", { "more than 1000000" } },
-  { "CornerWithFourNumbers", jellyLine(7, "    top_right: [0.2, 0, 1.3, 1]"), "jelly.yaml:7: bodies[0].top_right",
+const BadKeys kBadJellies[] = {
+  { "NoCells", replaceKeyLine(kJellyKeys, 4, "    nx: 0"), "jelly.yaml:4: bodies[0].nx", { "[1, 1000000]", "got 0" } },
+  { "NyIsAWord", replaceKeyLine(kJellyKeys, 5, "    ny: three"), "jelly.yaml:5: bodies[0].ny", { "expected an integer", "'three'" } },
+  { "GridTooLarge", replaceKeyLine(kJellyKeys, 5, "    ny: 999999"), "jelly.yaml:5: bodies[0].ny", { "more than 1000000" } },
+  { "CornerWithFourNumbers", replaceKeyLine(kJellyKeys, 7, "    top_right: [0.2, 0, 1.3, 1]"), "jelly.yaml:7: bodies[0].top_right",
     { "expected a list of 3 numbers", "4 item(s)" } },
-  { "CoincidentCorners", jellyLine(8, "    bottom_left: [0, 0, 1.3]"), "jelly.yaml:8: bodies[0].bottom_left",
+  { "CoincidentCorners", replaceKeyLine(kJellyKeys, 8, "    bottom_left: [0, 0, 1.3]"), "jelly.yaml:8: bodies[0].bottom_left",
     { "must span a parallelogram" } },
-  { "NegativeMass", jellyLine(9, "    mass: -0.6"), "jelly.yaml:9: bodies[0].mass", { "must be > 0" } },
-  { "EdgesWithoutStiffness", jellyLine(10, "    edges: {damping: 0.5}"), "jelly.yaml:10: bodies[0].edges.stiffness",
+  { "NegativeMass", replaceKeyLine(kJellyKeys, 9, "    mass: -0.6"), "jelly.yaml:9: bodies[0].mass", { "must be > 0" } },
+  { "EdgesWithoutStiffness", replaceKeyLine(kJellyKeys, 10, "    edges: {damping: 0.5}"), "jelly.yaml:10: bodies[0].edges.stiffness",
     { "missing required key" } },
-  { "DiagonalsIsAList", jellyLine(11, "    diagonals: [250]"), "jelly.yaml:11: bodies[0].diagonals",
+  { "DiagonalsIsAList", replaceKeyLine(kJellyKeys, 11, "    diagonals: [250]"), "jelly.yaml:11: bodies[0].diagonals",
     { "expected a mapping", "a list" } },
-  { "NegativeDiagonalDamping", jellyLine(11, "    diagonals: {stiffness: 250, damping: -2}"),
+  { "NegativeDiagonalDamping", replaceKeyLine(kJellyKeys, 11, "    diagonals: {stiffness: 250, damping: -2}"),
     "jelly.yaml:11: bodies[0].diagonals.damping", { "must be >= 0" } },
-  { "ZeroPressure", jellyLine(12, "    pressure: 0"), "jelly.yaml:12: bodies[0].pressure", { "must be > 0" } },
-  { "PressureIsQuoted", jellyLine(12, "    pressure: \"300\""), "jelly.yaml:12: bodies[0].pressure",
+  { "ZeroPressure", replaceKeyLine(kJellyKeys, 12, "    pressure: 0"), "jelly.yaml:12: bodies[0].pressure", { "must be > 0" } },
+  { "PressureIsQuoted", replaceKeyLine(kJellyKeys, 12, "    pressure: \"300\""), "jelly.yaml:12: bodies[0].pressure",
     { "expected a number", "quoted string" } },
-  { "PressureMissing", jellyLine(12, ""), "jelly.yaml:2: bodies[0].pressure", { "missing required key" } },
+  { "PressureMissing", replaceKeyLine(kJellyKeys, 12, ""), "jelly.yaml:2: bodies[0].pressure", { "missing required key" } },
   { "PinnedIsNotAJellyKey", std::string(kJellyKeys) + "    pinned: [0]\n", "jelly.yaml:13: bodies[0].pinned",
     { "unknown key 'pinned'", "nx, ny, top_left, top_right, bottom_left, mass, edges, diagonals, pressure" } },
 };

@@ -277,17 +277,8 @@ TEST(RopeKeys, OptionalKeysDefaultToNoDampingNoBendingNothingPinned)
     EXPECT_FALSE(node.pinned);
 }
 
-struct BadRope
-{
-  const char* name;
-  const char* keys;      ///< the body's keys after name and type (lines 4 onwards)
-  const char* location;  ///< "rope.yaml:<line>: <key path>"
-  std::vector<std::string> reason_words;
-};
 
-void PrintTo(const BadRope& bad, std::ostream* out) { *out << bad.name; }
-
-class RopeKeysReject : public ::testing::TestWithParam<BadRope>
+class RopeKeysReject : public ::testing::TestWithParam<BadKeys>
 {
 };
 
@@ -300,7 +291,7 @@ TEST_P(RopeKeysReject, WithOneLineNamingFileLineKeyAndReason)
 // Valid keys, line by line from line 4: nodes, from, to, mass, stiffness.
 #define ROPE_FROM_LINE_5 "    from: [0, 0, 0]\n    to: [1, 0, 0]\n    mass: 1\n    stiffness: 5\n"
 
-const BadRope kBadRopes[] = {
+const BadKeys kBadRopes[] = {
   { "NodesMissing", "    from: [0, 0, 0]\n    to: [1, 0, 0]\n    mass: 1\n    stiffness: 5\n",
     "rope.yaml:2: bodies[0].nodes", { "missing required key" } },
   { "NodesIsAWord", "    nodes: many\n" ROPE_FROM_LINE_5, "rope.yaml:4: bodies[0].nodes", { "expected an integer", "'many'" } },
