@@ -8,6 +8,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "soft_body_sim/SimState.h"
+#include "wait_for.h"
 
 namespace soft_body_sim
 {
@@ -26,19 +27,6 @@ protected:
         "/soft_body_sim/markers", 10, [this](const visualization_msgs::MarkerArray::ConstPtr& m) { markers_ = *m; });
     target_pub_ = nh_.advertise<geometry_msgs::PoseStamped>("/soft_body_sim/codeling/target", 10);
     ASSERT_TRUE(waitFor([this] { return state_count_ > 0 && !markers_.markers.empty(); }, 20.0));
-  }
-
-  bool waitFor(const std::function<bool()>& condition, double timeout)
-  {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-    while (ros::ok() && ros::WallTime::now() < end)
-    {
-      ros::spinOnce();
-      if (condition())
-        return true;
-      ros::WallDuration(0.005).sleep();
-    }
-    return false;
   }
 
   const BodyState& body(const std::string& name) const

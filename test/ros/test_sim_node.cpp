@@ -15,6 +15,7 @@
 #include <visualization_msgs/MarkerArray.h>
 
 #include "soft_body_sim/SimState.h"
+#include "wait_for.h"
 #include "soft_body_sim/scene/scene_loader.h"
 
 namespace soft_body_sim
@@ -59,19 +60,6 @@ protected:
     setPaused(false);
     ASSERT_TRUE(waitFor([this] { return state_count_ > 0 && marker_count_ > 0; }, 10.0));
     ASSERT_TRUE(waitFor([this] { return start_pub_.getNumSubscribers() > 0 && end_pub_.getNumSubscribers() > 0; }, 10.0));
-  }
-
-  bool waitFor(const std::function<bool()>& condition, double timeout)
-  {
-    const ros::WallTime end = ros::WallTime::now() + ros::WallDuration(timeout);
-    while (ros::ok() && ros::WallTime::now() < end)
-    {
-      ros::spinOnce();
-      if (condition())
-        return true;
-      ros::WallDuration(0.002).sleep();
-    }
-    return false;
   }
 
   /// Waits for `count` more state messages.
