@@ -10,9 +10,9 @@
 
 #include <benchmark/benchmark.h>
 
-#include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/forces.h"
+#include "large_cloth.h"
 
 namespace soft_body_sim
 {
@@ -69,24 +69,10 @@ void BM_RopeStepMinimalLoop(benchmark::State& bench)
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.springs.size()));
 }
 
-/// config/scenes/cloth.yaml's cloth with `nodes` nodes (a square grid) of the same node mass and
-/// springs, pinned at two corners, flat and falling: every spring is updated every step.
+/// The benchmarks' cloth (large_cloth.h) with about `nodes` nodes, a square grid.
 SceneDef clothScene(int nodes, IntegratorType integrator)
 {
-  const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(nodes))));
-  ClothDef cloth;
-  cloth.nx = cloth.ny = side;
-  cloth.mass = 0.3 / 225.0 * side * side;
-  cloth.structural = SpringParameters{ 1000.0, 0.02 };
-  cloth.shear = SpringParameters{ 200.0, 0.01 };
-  cloth.bending = SpringParameters{ 20.0, 0.0 };
-  cloth.pinned = { 0, side - 1 };
-  SceneDef scene;
-  scene.physics.integrator = integrator;
-  // Stable for the explicit scheme: omega_max ~ 3500 1/s at this node mass.
-  scene.physics.step.dt = 2e-4;
-  scene.bodies.push_back(buildCloth("cloth", cloth));
-  return scene;
+  return largeClothScene(static_cast<int>(std::lround(std::sqrt(static_cast<double>(nodes)))), integrator);
 }
 
 void BM_ClothStep(benchmark::State& bench, IntegratorType integrator)

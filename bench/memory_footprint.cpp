@@ -10,7 +10,7 @@
 #include <fstream>
 #include <string>
 
-#include "soft_body_sim/core/bodies/cloth.h"
+#include "large_cloth.h"
 
 namespace
 {
@@ -47,22 +47,8 @@ int main(int argc, char** argv)
   const int side = static_cast<int>(std::lround(std::sqrt(static_cast<double>(requested))));
 
   const double heap_before = heapBytes();
-  World world = [&] {
-    // The cloth of config/scenes/cloth.yaml, larger: same node mass and springs, pinned at two corners,
-    // at a step every integrator is stable at (memory does not depend on it).
-    SceneDef scene;
-    scene.physics.integrator = integrator;
-    scene.physics.step.dt = 2e-4;
-    ClothDef cloth;
-    cloth.nx = cloth.ny = side;
-    cloth.mass = 0.3 / 225.0 * side * side;
-    cloth.structural = SpringParameters{ 1000.0, 0.02 };
-    cloth.shear = SpringParameters{ 200.0, 0.01 };
-    cloth.bending = SpringParameters{ 20.0, 0.0 };
-    cloth.pinned = { 0, side - 1 };
-    scene.bodies.push_back(buildCloth("cloth", cloth));
-    return buildWorld(scene);
-  }();  // the scene definition is gone once the world is built
+  // The benchmarks' cloth (large_cloth.h); the scene definition is gone once the world is built.
+  World world = buildWorld(largeClothScene(side, integrator));
   for (int s = 0; s < steps; ++s)
     world.step();
   const double heap = heapBytes() - heap_before;
