@@ -39,6 +39,12 @@ inline void expectSceneError(const std::string& yaml, const std::string& locatio
   expectSceneError([&] { parseScene(yaml, "bad.yaml"); }, yaml, location, reason_words);
 }
 
+/// A scene file "<type>.yaml" holding one body `name` of `type` whose keys, from line 4 on, are `keys`.
+inline SceneDef parseBodyKeys(const std::string& type, const std::string& name, const std::string& keys)
+{
+  return parseScene("bodies:\n  - name: " + name + "\n    type: " + type + "\n" + keys, type + ".yaml");
+}
+
 /// One row of a table of bad keys for a generated body type: `keys` (the body's keys from line 4 on)
 /// must be rejected with a message starting "<location>: " that contains every word of `reason_words`.
 struct BadKeys

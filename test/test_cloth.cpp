@@ -222,7 +222,7 @@ TEST(ClothScene, CornersStayExactlyAndTheSettledStrainStaysBelowTheWeightOverOne
 
 SceneDef clothScene(const std::string& keys)
 {
-  return parseScene("bodies:\n  - name: c\n    type: cloth\n" + keys, "cloth.yaml");
+  return parseBodyKeys("cloth", "c", keys);
 }
 
 // Valid keys from line 4 on; the bad cases below replace or append lines.

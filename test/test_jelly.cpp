@@ -746,7 +746,7 @@ TEST(StabilityWarnings, SubstepsAndDragCount)
 
 SceneDef jellyScene(const std::string& keys)
 {
-  return parseScene("bodies:\n  - name: j\n    type: jelly\n" + keys, "jelly.yaml");
+  return parseBodyKeys("jelly", "j", keys);
 }
 
 const char* const kJellyKeys = R"(    nx: 2

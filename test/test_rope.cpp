@@ -236,7 +236,7 @@ TEST(StringScene, TheAnchoredMiddleStaysExactlyWhileBothHalvesFallAndSwingBelowI
 /// The rope of a scene, from a body mapping's keys.
 SceneDef ropeScene(const std::string& keys)
 {
-  return parseScene("bodies:\n  - name: r\n    type: rope\n" + keys, "rope.yaml");
+  return parseBodyKeys("rope", "r", keys);
 }
 
 TEST(RopeKeys, EveryKeyIsRead)
