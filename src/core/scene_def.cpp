@@ -99,8 +99,9 @@ World buildWorld(const SceneDef& scene)
   StepSettings step = scene.physics.step;
   if (scene.physics.auto_dt)
     step = chooseStableStep(model, state, scene.physics.integrator, step.iterations);
-  return World(std::move(model), std::move(state), scene.physics.integrator, step,
-               std::move(controllers));
+  World world(std::move(model), std::move(state), scene.physics.integrator, step, std::move(controllers));
+  world.setGuard(scene.physics.guard);
+  return world;
 }
 
 }  // namespace soft_body_sim

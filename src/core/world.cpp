@@ -1,7 +1,11 @@
 #include "soft_body_sim/core/world.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <iterator>
 #include <stdexcept>
+#include <utility>
 
 #include "soft_body_sim/core/collisions.h"
 #include "soft_body_sim/core/forces.h"
@@ -23,6 +27,10 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
   , built_constraints_(model_.constraints)
   , built_cells_(model_.cells)
   , body_scaling_(model_.bodies.size())
+  , body_integrator_(model_.bodies.size(), integrator)
+  , last_good_(state_)
+  , frozen_(model_.bodies.size())
+  , body_divergences_(model_.bodies.size())
 {
   const Eigen::Index n = model_.nodeCount();
   if (model_.inverse_mass.size() != n || state_.position.cols() != n || state_.velocity.cols() != n)
@@ -36,6 +44,8 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
 
 void World::step()
 {
+  if (groups_dirty_)
+    rebuildGroups();
   const double dt = settings_.dt;
   const double h = dt / settings_.substeps;
   for (std::size_t k = 0; k < model_.anchors.size(); ++k)
@@ -50,11 +60,11 @@ void World::step()
     {
       for (const Anchor& anchor : model_.anchors)
         state_.position.col(anchor.node) += h * state_.velocity.col(anchor.node);
-      integrator_->invalidate();
+      invalidateIntegrators();
     }
-    integrator_->step(model_, state_, h, settings_.iterations);
+    stepIntegrators(h);
     if (!model_.planes.empty() && collideWithPlanes(model_, state_, resting_speed, touching_))
-      integrator_->invalidate();
+      invalidateIntegrators();
   }
   // Land exactly on the anchor goals (the sub-step sums differ from them by round-off).
   for (std::size_t k = 0; k < model_.anchors.size(); ++k)
@@ -64,6 +74,176 @@ void World::step()
       anchor_goals_[k].reset();
     }
   ++steps_;
+  guardBodies();
+}
+
+void World::stepIntegrators(double h)
+{
+  if (groups_.empty())
+    integrator_->step(model_, state_, h, settings_.iterations);
+  for (IntegratorGroup& group : groups_)
+    group.integrator->step(group.model, state_, h, settings_.iterations);
+}
+
+void World::invalidateIntegrators()
+{
+  integrator_->invalidate();
+  for (IntegratorGroup& group : groups_)
+    group.integrator->invalidate();
+}
+
+void World::modelChanged()
+{
+  invalidateIntegrators();
+  if (!groups_.empty())
+    groups_dirty_ = true;
+}
+
+void World::rebuildGroups()
+{
+  groups_dirty_ = false;
+  groups_.clear();
+  // Each node goes with its body's integrator; a node of no body with the scene's.
+  std::vector<IntegratorType> node_type(static_cast<std::size_t>(model_.nodeCount()), integrator_type_);
+  for (std::size_t b = 0; b < model_.bodies.size(); ++b)
+  {
+    const BodyRange& body = model_.bodies[b];
+    for (int i = body.first; i < body.first + body.count; ++i)
+      node_type[static_cast<std::size_t>(i)] = body_integrator_[b];
+  }
+  std::vector<IntegratorType> types;
+  for (const IntegratorType type : node_type)
+    if (std::find(types.begin(), types.end(), type) == types.end())
+      types.push_back(type);
+  if (types.size() == 1 && types.front() == integrator_type_)
+    return;  // every node is on the scene's integrator: one model, no copies
+  for (const IntegratorType type : types)
+  {
+    const auto mine = [&](int node) { return node_type[static_cast<std::size_t>(node)] == type; };
+    IntegratorGroup group{ type, model_, makeIntegrator(type) };
+    Model& m = group.model;
+    for (int i = 0; i < m.nodeCount(); ++i)
+      if (!mine(i))
+        m.inverse_mass[i] = 0.0;
+    // Elements between two other nodes only; collisions are the world's stage, not the group's.
+    m.springs.clear();
+    std::copy_if(model_.springs.begin(), model_.springs.end(), std::back_inserter(m.springs),
+                 [&](const Spring& s) { return mine(s.a) || mine(s.b); });
+    m.constraints.clear();
+    std::copy_if(model_.constraints.begin(), model_.constraints.end(), std::back_inserter(m.constraints),
+                 [&](const DistanceConstraint& c) { return mine(c.a) || mine(c.b); });
+    m.cells.clear();
+    std::copy_if(model_.cells.begin(), model_.cells.end(), std::back_inserter(m.cells), [&](const PressureCell& c) {
+      return std::any_of(std::begin(c.nodes), std::end(c.nodes), mine);
+    });
+    m.planes.clear();
+    groups_.push_back(std::move(group));
+  }
+}
+
+void World::setGuard(const GuardSettings& guard)
+{
+  if (!(guard.max_speed > 0.0 && std::isfinite(guard.max_speed)))
+    throw std::invalid_argument("World: guard max_speed must be a finite number > 0 [m/s]");
+  guard_ = guard;
+}
+
+std::vector<DivergenceEvent> World::takeDivergenceEvents() { return std::exchange(events_, {}); }
+
+void World::guardBodies()
+{
+  bool restored = false;
+  for (std::size_t b = 0; b < model_.bodies.size(); ++b)
+  {
+    const BodyRange& body = model_.bodies[b];
+    if (frozen_[b])
+      continue;
+    std::string reason = divergence(body);
+    if (reason.empty())
+      continue;
+    // Free nodes only: pinned ones belong to the anchors and controllers, which moved them on purpose.
+    for (int i = body.first; i < body.first + body.count; ++i)
+      if (model_.isFree(i))
+      {
+        state_.position.col(i) = last_good_.position.col(i);
+        state_.velocity.col(i) = last_good_.velocity.col(i);
+      }
+    restored = true;
+    ++divergence_count_;
+    ++body_divergences_[b];
+    std::string action = treatDiverged(b);
+    events_.push_back({ body.name, time(), std::move(reason), std::move(action) });
+  }
+  if (restored)
+    invalidateIntegrators();
+  last_good_.position = state_.position;  // same size: no allocation
+  last_good_.velocity = state_.velocity;
+}
+
+std::string World::divergence(const BodyRange& body) const
+{
+  char text[160];
+  const double max_speed2 = guard_.max_speed * guard_.max_speed;
+  for (int i = body.first; i < body.first + body.count; ++i)
+  {
+    if (!model_.isFree(i))
+      continue;
+    if (!state_.position.col(i).allFinite() || !state_.velocity.col(i).allFinite())
+    {
+      std::snprintf(text, sizeof text, "node %d is not finite", i - body.first);
+      return text;
+    }
+    const double speed2 = state_.velocity.col(i).squaredNorm();
+    if (speed2 > max_speed2)
+    {
+      std::snprintf(text, sizeof text, "node %d moves at %.3g m/s > max_speed %.3g m/s", i - body.first,
+                    std::sqrt(speed2), guard_.max_speed);
+      return text;
+    }
+  }
+  return {};
+}
+
+std::string World::treatDiverged(std::size_t body)
+{
+  const IntegratorType type = body_integrator_[body];
+  switch (guard_.policy)
+  {
+    case GuardPolicy::HalveStep:
+      if (2 * settings_.substeps > kGuardMaxSubsteps)
+        return "already at " + std::to_string(settings_.substeps) + " sub-steps per step: " + freeze(body);
+      settings_.substeps *= 2;
+      invalidateIntegrators();  // a multistep history (verlet) holds the old h
+      {
+        char text[120];
+        std::snprintf(text, sizeof text, "sub-step halved to %.3g s (%d per step, every body)",
+                      settings_.dt / settings_.substeps, settings_.substeps);
+        return text;
+      }
+    case GuardPolicy::SwitchIntegrator:
+      if (type == IntegratorType::ImplicitEuler || type == IntegratorType::Xpbd)
+        return "already on " + integratorName(type) + ", stable at any step: " + freeze(body);
+      body_integrator_[body] = IntegratorType::ImplicitEuler;
+      groups_dirty_ = true;
+      return "switched from " + integratorName(type) + " to implicit_euler";
+    case GuardPolicy::Freeze:
+      break;
+  }
+  return freeze(body);
+}
+
+std::string World::freeze(std::size_t body)
+{
+  frozen_[body] = 1;
+  const BodyRange& range = model_.bodies[body];
+  for (int i = range.first; i < range.first + range.count; ++i)
+    if (model_.isFree(i))
+    {
+      model_.inverse_mass[i] = 0.0;
+      state_.velocity.col(i).setZero();
+    }
+  modelChanged();
+  return "frozen (its free nodes pinned at rest)";
 }
 
 bool World::driveKinematicNodes(double dt)
@@ -111,7 +291,7 @@ void World::setNode(int node, const Vec3& position, const Vec3& velocity)
 {
   state_.position.col(node) = position;
   state_.velocity.col(node) = velocity;
-  integrator_->invalidate();
+  invalidateIntegrators();
 }
 
 void World::setStepSettings(const StepSettings& settings)
@@ -122,7 +302,7 @@ void World::setStepSettings(const StepSettings& settings)
   time_origin_ = time();
   steps_origin_ = steps_;
   settings_ = settings;
-  integrator_->invalidate();  // a multistep history (verlet) holds the old h
+  invalidateIntegrators();  // a multistep history (verlet) holds the old h
 }
 
 void World::setIntegrator(IntegratorType type)
@@ -130,6 +310,9 @@ void World::setIntegrator(IntegratorType type)
   // Every integrator's state is (x, v) plus caches it rebuilds from them: a fresh one continues.
   integrator_ = makeIntegrator(type);
   integrator_type_ = type;
+  std::fill(body_integrator_.begin(), body_integrator_.end(), type);
+  groups_.clear();
+  groups_dirty_ = false;
 }
 
 void World::setGravity(const Vec3& gravity)
@@ -137,7 +320,7 @@ void World::setGravity(const Vec3& gravity)
   if (!gravity.allFinite())
     throw std::invalid_argument("World: gravity must be finite");
   model_.gravity = gravity;
-  integrator_->invalidate();  // a cached acceleration (velocity_verlet) holds the old gravity
+  modelChanged();  // a cached acceleration (velocity_verlet) holds the old gravity
 }
 
 void World::setDrag(double drag)
@@ -145,7 +328,7 @@ void World::setDrag(double drag)
   if (!(drag >= 0.0 && std::isfinite(drag)))
     throw std::invalid_argument("World: drag must be finite and >= 0");
   model_.drag = drag;
-  integrator_->invalidate();
+  modelChanged();
 }
 
 std::size_t World::bodyOf(int node) const
@@ -182,7 +365,7 @@ bool World::setBodyScaling(const std::string& body, const BodyScaling& scaling)
   for (std::size_t k = 0; k < model_.cells.size(); ++k)
     if (bodyOf(built_cells_[k].nodes[0]) == b)
       model_.cells[k].pressure = built_cells_[k].pressure * scaling.pressure;
-  integrator_->invalidate();
+  modelChanged();
   return true;
 }
 
@@ -229,7 +412,7 @@ int World::attach(int node, const std::string& name)
   model_.anchors.push_back({ body, name, node });
   anchor_goals_.emplace_back();
   anchor_paths_.emplace_back();
-  integrator_->invalidate();
+  modelChanged();
   return static_cast<int>(model_.anchors.size()) - 1;
 }
 
@@ -239,11 +422,12 @@ bool World::detach(int anchor)
     return false;
   const auto k = static_cast<std::size_t>(anchor);
   const int node = model_.anchors[k].node;
-  model_.inverse_mass[node] = 1.0 / model_.mass[node];
+  // A node of a frozen body stays pinned: the guard froze it there.
+  model_.inverse_mass[node] = frozen_[bodyOf(node)] ? 0.0 : 1.0 / model_.mass[node];
   model_.anchors.erase(model_.anchors.begin() + anchor);
   anchor_goals_.erase(anchor_goals_.begin() + anchor);
   anchor_paths_.erase(anchor_paths_.begin() + anchor);
-  integrator_->invalidate();
+  modelChanged();
   return true;
 }
 

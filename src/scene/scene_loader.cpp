@@ -18,7 +18,8 @@ namespace
 using namespace scene_yaml;
 
 const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "bodies" };
-const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag" };
+const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag", "guard" };
+const Keys kGuardKeys = { "policy", "max_speed" };
 const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
 const Keys kAnchorKeys = { "name", "node", "frame" };
 
@@ -31,6 +32,21 @@ IntegratorType readIntegrator(const Context& ctx, const Field& field)
   if (!integratorFromName(name, type))
     ctx.fail(field, "unknown integrator " + quoted(name) + "; valid integrators: " + join(integratorNames()));
   return type;
+}
+
+GuardSettings readGuard(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, kGuardKeys);
+  GuardSettings guard;
+  if (const std::optional<Field> value = optionalKey(field, "policy"))
+  {
+    const std::string name = readNonEmptyString(ctx, *value);
+    if (!guardPolicyFromName(name, guard.policy))
+      ctx.fail(*value, "unknown policy " + quoted(name) + "; valid policies: " + join(guardPolicyNames()));
+  }
+  if (const std::optional<Field> value = optionalKey(field, "max_speed"))
+    guard.max_speed = readPositive(ctx, *value);
+  return guard;
 }
 
 PhysicsDef readPhysics(const Context& ctx, const Field& field)
@@ -55,6 +71,8 @@ PhysicsDef readPhysics(const Context& ctx, const Field& field)
     physics.gravity = readVec3(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "drag"))
     physics.drag = readNonNegative(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "guard"))
+    physics.guard = readGuard(ctx, *value);
   return physics;
 }
 

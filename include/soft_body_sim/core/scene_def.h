@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/guard.h"
 #include "soft_body_sim/core/integrator.h"
 #include "soft_body_sim/core/model.h"
 #include "soft_body_sim/core/world.h"
@@ -85,6 +86,7 @@ struct PhysicsDef
   bool auto_dt = false;
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);     ///< [m/s^2]
   double drag = 0.0;                        ///< [1/s]
+  GuardSettings guard;                      ///< what the divergence guard does (guard.h)
 };
 
 struct SceneDef

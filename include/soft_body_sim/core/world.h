@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/guard.h"
 #include "soft_body_sim/core/integrator.h"
 #include "soft_body_sim/core/model.h"
 
@@ -42,7 +43,7 @@ public:
 
   /// Advances the simulation by settings().dt [s]. Stages: controllers drive their nodes; anchors set
   /// their nodes' velocities toward their new poses; then per sub-step of dt / substeps: anchors move,
-  /// the integrator steps, planes push nodes out.
+  /// the integrator(s) step, planes push nodes out; last, the divergence guard checks every body.
   void step();
 
   /// Simulated time [s] = number of steps taken * dt (no accumulated round-off); after setStepSettings,
@@ -53,7 +54,10 @@ public:
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
   const StepSettings& settings() const { return settings_; }
+  /// The scene's integrator (setIntegrator's); a body the guard switched may use another.
   IntegratorType integrator() const { return integrator_type_; }
+  /// The integrator stepping body `body` (index into model().bodies).
+  IntegratorType bodyIntegrator(std::size_t body) const { return body_integrator_.at(body); }
   const std::vector<BodyController>& controllers() const { return controllers_; }
 
   /// Index of the anchor `anchor` of body `body` in model().anchors, or nullopt.
@@ -71,7 +75,7 @@ public:
   /// New dt [s] (> 0), substeps and iterations (>= 1); simulated time goes on from time(). Throws
   /// std::invalid_argument on a bad value and keeps the old settings.
   void setStepSettings(const StepSettings& settings);
-  /// Switches the integrator; the new one starts from the current positions and velocities.
+  /// Switches the integrator of every body; the new one starts from the current positions and velocities.
   void setIntegrator(IntegratorType type);
   /// [m/s^2], finite; throws std::invalid_argument otherwise.
   void setGravity(const Vec3& gravity);
@@ -103,11 +107,46 @@ public:
   /// Kinetic + potential energy [J] (see forces.h).
   double energy() const;
 
+  // --- the divergence guard (guard.h) ---------------------------------------------------------------
+  /// Throws std::invalid_argument if max_speed is not a finite number > 0.
+  void setGuard(const GuardSettings& guard);
+  const GuardSettings& guard() const { return guard_; }
+  /// Catches since the world was made, over all bodies / of body `body` (index into model().bodies).
+  std::int64_t divergenceCount() const { return divergence_count_; }
+  std::int64_t divergenceCount(std::size_t body) const { return body_divergences_.at(body); }
+  /// True once the guard froze body `body`.
+  bool isFrozen(std::size_t body) const { return frozen_.at(body) != 0; }
+  /// The catches since the last call, oldest first, for the caller to log.
+  std::vector<DivergenceEvent> takeDivergenceEvents();
+
 private:
   /// Controllers and anchors set their nodes for this step; true if any kinematic node moves.
   bool driveKinematicNodes(double dt);
   /// Index into model().bodies of the body holding `node`.
   std::size_t bodyOf(int node) const;
+  /// The integrators step one sub-step h: one for the whole model while every body uses the same,
+  /// else one per integrator over a copy of the model in which the other bodies' nodes are pinned.
+  void stepIntegrators(double h);
+  /// The model's parameters or pinning changed: integrators drop their caches, groups are rebuilt.
+  void modelChanged();
+  void invalidateIntegrators();
+  void rebuildGroups();
+  /// The guard stage: checks every body, restores and treats the diverged ones, keeps the good state.
+  void guardBodies();
+  /// Why body `body` counts as diverged now, or empty.
+  std::string divergence(const BodyRange& body) const;
+  /// Applies guard_.policy to body `body` and says what it did.
+  std::string treatDiverged(std::size_t body);
+  std::string freeze(std::size_t body);
+
+  /// Bodies stepped by one integrator type when bodies differ: the model with every other body's
+  /// nodes pinned (their positions and velocities belong to their own group, as an anchor's to us).
+  struct IntegratorGroup
+  {
+    IntegratorType type;
+    Model model;
+    std::unique_ptr<Integrator> integrator;
+  };
 
   Model model_;
   State state_;
@@ -128,6 +167,15 @@ private:
   std::int64_t steps_origin_ = 0;   ///< step count then
   std::vector<std::uint8_t> touching_;              ///< per node: on a plane after the last sub-step
   std::int64_t steps_ = 0;
+  std::vector<IntegratorType> body_integrator_;     ///< per body
+  std::vector<IntegratorGroup> groups_;             ///< empty while every body uses integrator_
+  bool groups_dirty_ = false;
+  GuardSettings guard_;
+  State last_good_;                                 ///< the state after the last step the guard passed
+  std::vector<std::uint8_t> frozen_;                ///< per body
+  std::vector<std::int64_t> body_divergences_;      ///< per body
+  std::int64_t divergence_count_ = 0;
+  std::vector<DivergenceEvent> events_;             ///< not yet taken
 };
 
 }  // namespace soft_body_sim
