@@ -79,6 +79,27 @@ TEST(RosConverter, StateCarriesPositionsVelocitiesAndStatistics)
   ASSERT_EQ(state.bodies[1].velocities.size(), 2u);
   EXPECT_EQ(state.bodies[1].positions[0].y, 2.0);
   EXPECT_EQ(state.bodies[1].velocities[0].x, 0.5);
+  EXPECT_EQ(state.divergence_events, 0u);
+  EXPECT_EQ(state.bodies[0].integrator, "semi_implicit_euler");
+  EXPECT_EQ(state.bodies[0].divergence_events, 0u);
+  EXPECT_FALSE(state.bodies[0].frozen);
+}
+
+TEST(RosConverter, StateSaysWhatTheDivergenceGuardDidToEachBody)
+{
+  World world = twoBodies();
+  // A runaway node of the pair (body 1): caught, restored; the policy switches it to implicit_euler.
+  world.setNode(world.model().bodies[1].first, Vec3(1, 2, 3), Vec3(1e6, 0, 0));
+  world.step();
+  StepStatistics statistics;
+  statistics.divergence_events = 7;  // the node's count since it started, across resets
+  const SimState state = RosConverter::toState(world, "map", ros::Time(3.0), statistics);
+  EXPECT_EQ(state.divergence_events, 7u);
+  EXPECT_EQ(state.bodies[0].integrator, "semi_implicit_euler");
+  EXPECT_EQ(state.bodies[0].divergence_events, 0u);
+  EXPECT_EQ(state.bodies[1].integrator, "implicit_euler");
+  EXPECT_EQ(state.bodies[1].divergence_events, 1u);
+  EXPECT_FALSE(state.bodies[1].frozen);
 }
 
 TEST(RosConverter, AMarkerWithoutPointsIsSentAsDelete)

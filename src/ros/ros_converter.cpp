@@ -119,10 +119,15 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
   state.header.stamp = stamp;
   state.real_time_factor = statistics.real_time_factor;
   state.wall_seconds_per_step = statistics.wall_seconds_per_step;
-  for (const BodyRange& range : world.model().bodies)
+  state.divergence_events = statistics.divergence_events;
+  for (std::size_t b = 0; b < world.model().bodies.size(); ++b)
   {
+    const BodyRange& range = world.model().bodies[b];
     BodyState body;
     body.name = range.name;
+    body.integrator = integratorName(world.bodyIntegrator(b));
+    body.divergence_events = static_cast<std::uint32_t>(world.divergenceCount(b));
+    body.frozen = world.isFrozen(b);
     for (int i = range.first; i < range.first + range.count; ++i)
     {
       body.positions.push_back(point(world.state().position.col(i)));

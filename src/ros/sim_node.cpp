@@ -79,7 +79,6 @@ void SimNode::buildWorldFromScene()
         followFrame(*world_->findAnchor(body.name, anchor.name), anchor.frame);
   targets_.clear();
   inputs_.clear();
-  diverged_ = false;
 }
 
 void SimNode::onTimer(const ros::TimerEvent&)

@@ -12,8 +12,6 @@ namespace soft_body_sim
 {
 namespace
 {
-/// A spring or constraint stretched or squeezed by more than this is taken as a diverged simulation.
-constexpr double kDivergedStrain = 10.0;  // [-] (l - L) / L
 /// Below this real-time factor the node is reported as falling behind.
 constexpr double kSlowRealTimeFactor = 0.9;
 }  // namespace
@@ -114,25 +112,26 @@ void SimNode::watchDivergence()
     stretch(s.a, s.b, s.rest_length);
   for (const DistanceConstraint& c : model.constraints)
     stretch(c.a, c.b, c.rest_length);
-  const bool finite = x.allFinite() && world_->state().velocity.allFinite() && std::isfinite(strain);
-  max_strain_ = finite ? strain : std::numeric_limits<double>::infinity();
-  // Once diverged, a state stays so until ~reset: an exploding explicit scheme swings back through
-  // small strains on its way out, which is not a recovery.
-  const bool diverged = diverged_ || !finite || strain > kDivergedStrain;
-  if (diverged && !diverged_)
+  max_strain_ = std::isfinite(strain) ? strain : std::numeric_limits<double>::infinity();
+  // Each catch once, as it happens: a body is caught at most eleven times (ten halvings, then frozen).
+  for (const DivergenceEvent& event : world_->takeDivergenceEvents())
   {
-    ++divergence_events_;
-    ROS_ERROR("%s: the simulation diverged at t = %.3f s (%s); lower dt or stiffness, or pick a stable "
-              "integrator, then call ~reset",
-              name_.c_str(), world_->time(), finite ? "a spring stretched past 1000 %" : "non-finite values");
+    ++statistics_.divergence_events;
+    ROS_ERROR("%s: %s; lower dt or stiffness, or pick a stable integrator, then call ~reset", name_.c_str(),
+              event.describe().c_str());
   }
-  diverged_ = diverged;
 }
 
 void SimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
-  if (diverged_)
-    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "diverged: call ~reset after retuning");
+  std::string frozen;
+  for (std::size_t b = 0; b < world_->model().bodies.size(); ++b)
+    if (world_->isFrozen(b))
+      frozen += (frozen.empty() ? "" : ", ") + world_->model().bodies[b].name;
+  if (!frozen.empty())
+    status.summary(diagnostic_msgs::DiagnosticStatus::ERROR, "diverged and frozen: " + frozen + " (~reset after retuning)");
+  else if (world_->divergenceCount() > 0)
+    status.summary(diagnostic_msgs::DiagnosticStatus::WARN, "diverged and recovered: see the log");
   else if (paused_)
     status.summary(diagnostic_msgs::DiagnosticStatus::OK, "paused");
   else if (started_ && statistics_.real_time_factor > 0.0 && statistics_.real_time_factor < kSlowRealTimeFactor)
@@ -143,7 +142,7 @@ void SimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("real-time factor", statistics_.real_time_factor);
   status.add("step cost [s]", statistics_.wall_seconds_per_step);
   status.add("max strain", max_strain_);
-  status.add("divergence events", divergence_events_);
+  status.add("divergence events", statistics_.divergence_events);
   status.add("integrator", integratorName(world_->integrator()));
   status.add("dt [s]", world_->settings().dt);
   status.add("nodes", world_->model().nodeCount());

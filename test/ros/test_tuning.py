@@ -135,12 +135,23 @@ class TuningTest(unittest.TestCase):
             self.assertIn(key, values)
         self.assertLess(float(values["max strain"]), 1.0)
         events = int(values["divergence events"])
-        # Explicit Euler on stiff springs at 20 ms: w h = sqrt(2 k / m) h = 20 > 2, it explodes.
+        # Explicit Euler on stiff springs at 20 ms: w h = sqrt(2 k / m) h = 20 > 2, it explodes. The
+        # divergence guard restores the rope and steps it with implicit_euler from then on: one event,
+        # a warning, and never a non-finite value on ~state.
+        start = len(self.log)
         dynparam("set", NODE, "{integrator: explicit_euler, dt: 0.02}")
         dynparam("set", NODE + "/rope", "stiffness_scale", "100")
-        self.assertTrue(wait_for(lambda: self.diagnostics.level == DiagnosticStatus.ERROR, 20.0))
+        self.assertTrue(wait_for(lambda: self.diagnostics.level == DiagnosticStatus.WARN, 20.0))
         values = {kv.key: kv.value for kv in self.diagnostics.values}
         self.assertEqual(int(values["divergence events"]), events + 1)
+        rope = self.state.next(5).bodies[0]
+        self.assertEqual((rope.integrator, rope.divergence_events, rope.frozen), ("implicit_euler", 1, False))
+        self.assertEqual(self.state.latest.divergence_events, events + 1)
+        for state in self.state.states:
+            for p in state.bodies[0].positions:
+                self.assertTrue(all(map(math.isfinite, (p.x, p.y, p.z))))
+        self.assertTrue(wait_for(lambda: any("body 'rope' diverged at t = " in m.msg and "switched from explicit_euler "
+                                             "to implicit_euler" in m.msg for m in self.log[start:]), 5.0))
 
     def test_step_statistics_are_plottable_fields(self):
         # rqt_plot reads numeric fields by path, as `rostopic echo` does.

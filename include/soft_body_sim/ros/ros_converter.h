@@ -19,6 +19,7 @@ struct StepStatistics
 {
   double real_time_factor = 0.0;       ///< simulated seconds per wall second over the last tick [-]
   double wall_seconds_per_step = 0.0;  ///< wall time of one physics step [s]
+  unsigned divergence_events = 0;      ///< catches of the divergence guard since the node started
 };
 
 class RosConverter
@@ -31,7 +32,8 @@ public:
   static visualization_msgs::MarkerArray toMarkers(const World& world, const std::string& frame_id,
                                                    const ros::Time& stamp);
 
-  /// The state: per body its name, positions [m] and velocities [m/s], and the step statistics.
+  /// The state: per body its name, positions [m], velocities [m/s], integrator and what the divergence
+  /// guard did to it; and the step statistics.
   static SimState toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
                           const StepStatistics& statistics);
 

@@ -81,7 +81,7 @@ private:
   std::string applyBodyConfig(const std::string& body, const BodyConfig& config);
   SimConfig simConfigFromWorld() const;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
-  /// Counts a divergence event when the state turns non-finite or over-stretched.
+  /// Logs the divergence guard's catches of the last tick and measures the largest strain.
   void watchDivergence();
 
   bool onReset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
@@ -132,8 +132,6 @@ private:
   bool paused_ = false;
   StepStatistics statistics_;
   double max_strain_ = 0.0;       ///< [-] largest |l - L| / L of a spring or constraint, last tick
-  bool diverged_ = false;         ///< the state is non-finite or over-stretched now
-  int divergence_events_ = 0;     ///< times it became so
 };
 
 }  // namespace soft_body_sim
