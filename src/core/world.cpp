@@ -156,7 +156,7 @@ void World::guardBodies()
   for (std::size_t b = 0; b < model_.bodies.size(); ++b)
   {
     const BodyRange& body = model_.bodies[b];
-    if (frozen_[b])
+    if (frozen_[b] || looksGood(body))
       continue;
     std::string reason = divergence(body);
     if (reason.empty())
@@ -176,8 +176,21 @@ void World::guardBodies()
   }
   if (restored)
     invalidateIntegrators();
-  last_good_.position = state_.position;  // same size: no allocation
-  last_good_.velocity = state_.velocity;
+  if (!restored && steps_ % kGuardCheckpointSteps != 0)
+    return;
+  // Same sizes: a plain copy, no allocation.
+  std::copy_n(state_.position.data(), state_.position.size(), last_good_.position.data());
+  std::copy_n(state_.velocity.data(), state_.velocity.size(), last_good_.velocity.data());
+}
+
+bool World::looksGood(const BodyRange& body) const
+{
+  // Two vectorised sums over every node, pinned ones too: a sum is finite only if all its terms are,
+  // and sum |v_i|^2 <= max_speed^2 bounds every node's speed. A body that fails (a NaN compares false)
+  // gets the exact look, node by node, which leaves the pinned nodes (the caller's) out.
+  const double x_sum = state_.position.middleCols(body.first, body.count).sum();
+  const double v2_sum = state_.velocity.middleCols(body.first, body.count).squaredNorm();
+  return std::isfinite(x_sum) && v2_sum <= guard_.max_speed * guard_.max_speed;
 }
 
 std::string World::divergence(const BodyRange& body) const

@@ -133,6 +133,8 @@ private:
   void rebuildGroups();
   /// The guard stage: checks every body, restores and treats the diverged ones, keeps the good state.
   void guardBodies();
+  /// The guard's cheap check: true if body `body` is certainly fine (false says: look closer).
+  bool looksGood(const BodyRange& body) const;
   /// Why body `body` counts as diverged now, or empty.
   std::string divergence(const BodyRange& body) const;
   /// Applies guard_.policy to body `body` and says what it did.
@@ -171,7 +173,7 @@ private:
   std::vector<IntegratorGroup> groups_;             ///< empty while every body uses integrator_
   bool groups_dirty_ = false;
   GuardSettings guard_;
-  State last_good_;                                 ///< the state after the last step the guard passed
+  State last_good_;  ///< the state after the last step the guard saved (kGuardCheckpointSteps)
   std::vector<std::uint8_t> frozen_;                ///< per body
   std::vector<std::int64_t> body_divergences_;      ///< per body
   std::int64_t divergence_count_ = 0;
