@@ -64,6 +64,34 @@ std::vector<std::vector<std::string>> rows(const std::string& csv)
   return table;
 }
 
+TEST(Simulate, ReportsEachCatchOfTheDivergenceGuardOnStderr)
+{
+  // w h = 50 for symplectic Euler: the spring diverges within a few steps and the guard catches it.
+  const std::string scene = writeScene("stiff.yaml", R"(physics:
+  integrator: semi_implicit_euler
+  dt: 0.05
+  gravity: [0, 0, 0]
+  guard: {policy: freeze}
+bodies:
+  - name: spring
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 1, pinned: true}
+      - {position: [1.001, 0, 0], mass: 1}
+    springs:
+      - {nodes: [0, 1], stiffness: 1.0e6, rest_length: 1.0}
+)");
+  const Outcome r = runWith({ "--scene", scene, "--duration", "1" });
+  ASSERT_EQ(r.status, 0) << r.err;
+  const std::string caught = "simulate: warning: body 'spring' diverged at t = ";
+  ASSERT_NE(r.err.find(caught), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find(caught, r.err.find(caught) + 1), std::string::npos) << "reported more than once: " << r.err;
+  EXPECT_NE(r.err.find("frozen (its free nodes pinned at rest)"), std::string::npos) << r.err;
+  for (const auto& row : rows(r.out))
+    for (const std::string& cell : row)
+      EXPECT_EQ(cell.find("nan"), std::string::npos) << "a non-finite value in the CSV";
+}
+
 TEST(Simulate, WritesHeaderInitialAndFinalRowsAtFullPrecision)
 {
   const std::string scene = writeScene("tum.yaml", kTumScene);

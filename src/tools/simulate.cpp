@@ -185,6 +185,8 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
   for (long long n = 1; n <= steps; ++n)
   {
     world.step();
+    for (const DivergenceEvent& event : world.takeDivergenceEvents())
+      err << "simulate: warning: " << event.describe() << '\n';
     if (n == steps || (options.every && n % *options.every == 0))
       writeRows(csv, world);
   }
