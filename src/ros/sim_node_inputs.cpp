@@ -34,11 +34,15 @@ std::string badName(const std::string& what, const std::string& name)
   return std::string();
 }
 
-/// The parameter's value as written, for an error message.
+/// The parameter's value for an error message: a string quoted, a bool as a bool (XmlRpc writes 1).
 std::string shown(const ros::NodeHandle& nh, const std::string& key)
 {
   XmlRpc::XmlRpcValue value;
   nh.getParam(key, value);
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeBoolean)
+    return static_cast<bool>(value) ? "true" : "false";
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeString)
+    return "'" + static_cast<std::string>(value).substr(0, 64) + "'";
   std::ostringstream out;
   value.write(out);
   return out.str().substr(0, 64);
@@ -61,13 +65,14 @@ InputLimits SimNode::readInputLimits() const
   InputLimits limits;
   limits.max_age = positiveSeconds(private_nh_, "max_input_age", limits.max_age);
   limits.max_lead = positiveSeconds(private_nh_, "max_input_lead", limits.max_lead);
-  if (private_nh_.hasParam("max_held_inputs"))
+  // Read raw: roscpp's getParam(int) would round a double (2.5 -> 3) instead of refusing it.
+  XmlRpc::XmlRpcValue held;
+  if (private_nh_.getParam("max_held_inputs", held))
   {
-    int held = 0;
-    if (!private_nh_.getParam("max_held_inputs", held) || held < 1)
+    if (held.getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(held) < 1)
       throw std::runtime_error(private_nh_.resolveName("max_held_inputs") + ": must be an integer >= 1, not " +
                                shown(private_nh_, "max_held_inputs"));
-    limits.max_held = static_cast<std::size_t>(held);
+    limits.max_held = static_cast<std::size_t>(static_cast<int>(held));
   }
   return limits;
 }
