@@ -19,8 +19,8 @@ namespace
 /// while a tick holds the spinner (100 covers a 1 kHz source for 100 ms). Under a flood roscpp drops
 /// the oldest beyond it, so the latest still wins and memory stays bounded.
 constexpr int kInputQueueSize = 100;
-/// tf frame and body names longer than this are refused unread, so that a huge string in a request
-/// never reaches tf2 or a log line.
+/// tf frame and body names longer than this are refused by their length alone, so that a huge string
+/// in a request never reaches tf2 or a log line.
 constexpr std::size_t kMaxNameLength = 256;
 
 /// Why `name` cannot be a tf frame or body name (`what` says which), or empty.
@@ -28,9 +28,10 @@ std::string badName(const std::string& what, const std::string& name)
 {
   if (name.size() > kMaxNameLength)
     return what + " of " + std::to_string(name.size()) + " characters (at most " + std::to_string(kMaxNameLength) + ")";
+  // A newline or escape in a name would forge or garble the log lines that quote it.
   for (const char c : name)
-    if (!std::isprint(static_cast<unsigned char>(c)))
-      return what + " holds a control or non-ASCII character";
+    if (std::iscntrl(static_cast<unsigned char>(c)))
+      return what + " holds a control character";
   return std::string();
 }
 
