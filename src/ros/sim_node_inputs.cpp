@@ -1,6 +1,10 @@
 // SimNode's inputs: pose topics and rviz handles scheduled by stamp, anchors following tf frames, and
-// grasping with ~attach / ~detach.
+// grasping with ~attach / ~detach. Whatever arrives is checked before it reaches the world: a refused
+// input or request is named in a (throttled) warning and changes nothing.
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <sstream>
 
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
@@ -10,20 +14,80 @@ namespace soft_body_sim
 {
 namespace
 {
-/// An input stamped further ahead than this is taken as a clock mix-up (e.g. sim-time stamps into a
-/// wall-clock node) and applied now rather than held for ever.
-constexpr double kMaxLead = 5.0;  // [s]
+/// Messages a pose topic may queue between two turns of the node's spinner. Not 1, the ROS habit for
+/// "latest wins": every stamped input has a step of its own, and a replay is exact only if none is lost
+/// while a tick holds the spinner (100 covers a 1 kHz source for 100 ms). Under a flood roscpp drops
+/// the oldest beyond it, so the latest still wins and memory stays bounded.
+constexpr int kInputQueueSize = 100;
+/// tf frame and body names longer than this are refused by their length alone, so that a huge string
+/// in a request never reaches tf2 or a log line.
+constexpr std::size_t kMaxNameLength = 256;
+
+/// Why `name` cannot be a tf frame or body name (`what` says which), or empty.
+std::string badName(const std::string& what, const std::string& name)
+{
+  if (name.size() > kMaxNameLength)
+    return what + " of " + std::to_string(name.size()) + " characters (at most " + std::to_string(kMaxNameLength) + ")";
+  // A newline or escape in a name would forge or garble the log lines that quote it.
+  for (const char c : name)
+    if (std::iscntrl(static_cast<unsigned char>(c)))
+      return what + " holds a control character";
+  return std::string();
+}
+
+/// The parameter's value for an error message: a string quoted, a bool as a bool (XmlRpc writes 1).
+std::string shown(const ros::NodeHandle& nh, const std::string& key)
+{
+  XmlRpc::XmlRpcValue value;
+  nh.getParam(key, value);
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeBoolean)
+    return static_cast<bool>(value) ? "true" : "false";
+  if (value.getType() == XmlRpc::XmlRpcValue::TypeString)
+    return "'" + static_cast<std::string>(value).substr(0, 64) + "'";
+  std::ostringstream out;
+  value.write(out);
+  return out.str().substr(0, 64);
+}
+
+/// ~key in seconds, finite and > 0; `fallback` when it is not set. Throws, naming it, otherwise.
+double positiveSeconds(const ros::NodeHandle& nh, const std::string& key, double fallback)
+{
+  if (!nh.hasParam(key))
+    return fallback;
+  double value = 0.0;
+  if (!nh.getParam(key, value) || !(value > 0.0 && std::isfinite(value)))
+    throw std::runtime_error(nh.resolveName(key) + ": must be a finite number of seconds > 0, not " + shown(nh, key));
+  return value;
+}
 }  // namespace
+
+InputLimits SimNode::readInputLimits() const
+{
+  InputLimits limits;
+  limits.max_age = positiveSeconds(private_nh_, "max_input_age", limits.max_age);
+  limits.max_lead = positiveSeconds(private_nh_, "max_input_lead", limits.max_lead);
+  // Read raw: roscpp's getParam(int) would round a double (2.5 -> 3) instead of refusing it.
+  XmlRpc::XmlRpcValue held;
+  if (private_nh_.getParam("max_held_inputs", held))
+  {
+    if (held.getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(held) < 1)
+      throw std::runtime_error(private_nh_.resolveName("max_held_inputs") + ": must be an integer >= 1, not " +
+                               shown(private_nh_, "max_held_inputs"));
+    limits.max_held = static_cast<std::size_t>(static_cast<int>(held));
+  }
+  return limits;
+}
 
 void SimNode::subscribeInputs()
 {
+  inputs_.setLimits(readInputLimits());
   for (std::size_t k = 0; k < world_->model().anchors.size(); ++k)
   {
     const Anchor& anchor = world_->model().anchors[k];
     const std::string topic = private_nh_.resolveName(anchor.body + "/" + anchor.name + "/pose");
     const int id = static_cast<int>(k);
     subscribers_.push_back(private_nh_.subscribe<geometry_msgs::PoseStamped>(
-        topic, 10, [this, topic, id](const geometry_msgs::PoseStamped::ConstPtr& pose) {
+        topic, kInputQueueSize, [this, topic, id](const geometry_msgs::PoseStamped::ConstPtr& pose) {
           ScheduledInput input;
           input.kind = ScheduledInput::Kind::Anchor;
           input.anchor = id;
@@ -38,7 +102,7 @@ void SimNode::subscribeInputs()
     const std::string topic = private_nh_.resolveName(body.name + "/target");
     const std::string name = body.name;
     subscribers_.push_back(private_nh_.subscribe<geometry_msgs::PoseStamped>(
-        topic, 10, [this, topic, name](const geometry_msgs::PoseStamped::ConstPtr& pose) {
+        topic, kInputQueueSize, [this, topic, name](const geometry_msgs::PoseStamped::ConstPtr& pose) {
           ScheduledInput input;
           input.kind = ScheduledInput::Kind::Target;
           input.body = name;
@@ -78,15 +142,25 @@ void SimNode::addHandles()
 
 void SimNode::schedule(const std::string& topic, const ros::Time& stamp, const ScheduledInput& input)
 {
-  const ros::Time now = ros::Time::now();
-  ros::Time when = stamp.isZero() ? now : stamp;
-  if ((when - now).toSec() > kMaxLead)
+  const InputSchedule::Admission admission = inputs_.push(ros::Time::now(), stamp, input);
+  switch (admission.verdict)
   {
-    ROS_WARN_THROTTLE(5.0, "%s: stamp %.3f s ahead of the ROS clock (a clock mix-up?): applied now", topic.c_str(),
-                      (when - now).toSec());
-    when = now;
+    case InputSchedule::Verdict::Held:
+      break;
+    case InputSchedule::Verdict::Stale:
+      ROS_WARN_THROTTLE(5.0, "%s: input dropped: stamped %.3f s behind the ROS clock, more than ~max_input_age = %g s",
+                        topic.c_str(), -admission.offset, inputs_.limits().max_age);
+      break;
+    case InputSchedule::Verdict::TooFarAhead:
+      ROS_WARN_THROTTLE(5.0,
+                        "%s: input dropped: stamped %.3f s ahead of the ROS clock, more than ~max_input_lead = %g s "
+                        "(a clock mix-up? /use_sim_time differs between sender and simulator)",
+                        topic.c_str(), admission.offset, inputs_.limits().max_lead);
+      break;
   }
-  inputs_.push(when, input);
+  if (admission.evicted)
+    ROS_WARN_THROTTLE(5.0, "%s: %zu inputs waiting for their steps (~max_held_inputs): the earliest-stamped dropped",
+                      topic.c_str(), inputs_.limits().max_held);
 }
 
 void SimNode::applyDueInputs(const ros::Time& step_end)
@@ -122,6 +196,12 @@ bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::st
   if (pose.header.frame_id.empty())
   {
     ROS_WARN_THROTTLE(5.0, "%s: pose dropped: empty header.frame_id", topic.c_str());
+    return false;
+  }
+  why = badName("header.frame_id", pose.header.frame_id);
+  if (!why.empty())
+  {
+    ROS_WARN_THROTTLE(5.0, "%s: pose dropped: %s", topic.c_str(), why.c_str());
     return false;
   }
   if (pose.header.frame_id == scene_.frame_id)
@@ -199,8 +279,16 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
   };
   if (request.frame.empty())
     return refuse("no frame given");
+  for (const std::string& why : { badName("frame name", request.frame), badName("body name", request.body) })
+    if (!why.empty())
+      return refuse(why);
+  const std::vector<BodyRange>& bodies = world_->model().bodies;
+  if (!request.body.empty() && std::none_of(bodies.begin(), bodies.end(), [&](const BodyRange& body) {
+        return body.name == request.body;
+      }))
+    return refuse("no body '" + request.body + "' in the scene");
   if (!(request.radius > 0.0 && std::isfinite(request.radius)))
-    return refuse("radius must be a finite number > 0 [m]");
+    return refuse("radius must be a finite number > 0 [m], not " + std::to_string(request.radius));
   for (const Anchor& anchor : world_->model().anchors)
     if (anchor.name == request.frame && world_->isAttached(*world_->findAnchor(anchor.body, anchor.name)))
       return refuse("frame '" + request.frame + "' already holds a node of '" + anchor.body + "'");
@@ -228,6 +316,17 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
 
 bool SimNode::onDetach(Detach::Request& request, Detach::Response& response)
 {
+  const auto refuse = [&](const std::string& why) {
+    response.success = false;
+    response.message = why;
+    ROS_WARN("%s: detach refused: %s", name_.c_str(), why.c_str());
+    return true;
+  };
+  if (request.frame.empty())
+    return refuse("no frame given");
+  const std::string why = badName("frame name", request.frame);
+  if (!why.empty())
+    return refuse(why);
   const std::vector<Anchor>& anchors = world_->model().anchors;
   for (std::size_t k = 0; k < anchors.size(); ++k)
     if (anchors[k].name == request.frame && world_->isAttached(static_cast<int>(k)))
@@ -239,9 +338,7 @@ bool SimNode::onDetach(Detach::Request& request, Detach::Response& response)
       ROS_INFO("%s: %s", name_.c_str(), response.message.c_str());
       return true;
     }
-  response.success = false;
-  response.message = "frame '" + request.frame + "' holds nothing";
-  return true;
+  return refuse("frame '" + request.frame + "' holds nothing");
 }
 
 }  // namespace soft_body_sim

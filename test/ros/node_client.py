@@ -7,13 +7,14 @@ import rospy
 from soft_body_sim.msg import SimState
 
 
-def wait_for(condition, timeout):
-    """True as soon as condition() holds, False after `timeout` seconds of wall time."""
+def wait_for(condition, timeout, period=0.005):
+    """True as soon as condition() holds, False after `timeout` seconds of wall time; condition() is
+    asked every `period` seconds (longer for a question to the master)."""
     end = time.monotonic() + timeout
     while time.monotonic() < end and not rospy.is_shutdown():
         if condition():
             return True
-        time.sleep(0.005)
+        time.sleep(period)
     return condition()
 
 

@@ -1,15 +1,19 @@
 #!/usr/bin/python3
 """Inputs the ROS way (launched by inputs.test on frame_test_scene.yaml): the rope's first node follows
 the tf frame gripper_link, its last node has an rviz handle, and ~attach / ~detach grasp and release
-a node at another frame."""
+a node at another frame; bad requests and bad input parameters are refused with their reason."""
 import math
+import os
+import subprocess
 import threading
 import unittest
 
+import roslib.packages
 import rospy
 import rostest
 import tf2_ros
 from geometry_msgs.msg import PoseStamped, TransformStamped
+from rosgraph_msgs.msg import Log
 from std_srvs.srv import SetBool
 from visualization_msgs.msg import InteractiveMarkerFeedback, InteractiveMarkerInit
 
@@ -41,6 +45,8 @@ class InputsTest(unittest.TestCase):
         rospy.Subscriber(NODE + "/handles/update_full", InteractiveMarkerInit,
                          lambda m: setattr(cls, "handles", m), queue_size=1)
         cls.end_poses = []
+        cls.log = []
+        rospy.Subscriber("/rosout", Log, cls.log.append, queue_size=100)
         rospy.Subscriber(NODE + "/rope/end/pose", PoseStamped, cls.end_poses.append, queue_size=10)
         cls.feedback = rospy.Publisher(NODE + "/handles/feedback", InteractiveMarkerFeedback, queue_size=10)
         rospy.wait_for_service(NODE + "/attach", 20.0)
@@ -140,6 +146,58 @@ class InputsTest(unittest.TestCase):
         self.assertFalse(self.detach(frame="gripper2").success)
         # Free again: it falls back below the gripper.
         self.assertTrue(wait_for(lambda: self.state.node("rope", 2)[2] < 1.2, 10.0), self.state.node("rope", 2))
+
+    def test_bad_attach_and_detach_requests_are_refused_with_their_reason_and_a_log_line(self):
+        start = len(self.log)
+        attaches = [  # (frame, body, radius), a part of the reason
+            ("", "rope", 0.05, "no frame given"),
+            ("g" * 1000000, "rope", 0.05, "frame name of 1000000 characters"),
+            ("grip\nper", "rope", 0.05, "control"),
+            ("gripper_link", "b" * 300, 0.05, "body name of 300 characters"),
+            ("gripper_link", "no_such_body", 0.05, "no body 'no_such_body'"),
+            ("gripper_link", "rope", float("nan"), "radius must be a finite number > 0"),
+            ("gripper_link", "rope", float("inf"), "radius must be a finite number > 0"),
+            ("gripper_link", "rope", -0.1, "radius must be a finite number > 0"),
+            ("gripper_link", "rope", 0.0, "radius must be a finite number > 0"),
+        ]
+        for frame, body, radius, reason in attaches:
+            response = self.attach(frame=frame, body=body, radius=radius)
+            self.assertFalse(response.success, reason)
+            self.assertIn(reason, response.message)
+            self.assertLess(len(response.message), 200)  # a huge name is measured, not echoed
+        for frame, reason in (("", "no frame given"), ("d" * 1000000, "frame name of 1000000 characters"),
+                              ("gripper_link", "holds nothing"), ("never_attached", "holds nothing")):
+            response = self.detach(frame=frame)
+            self.assertFalse(response.success, reason)
+            self.assertIn(reason, response.message)
+        self.assertTrue(wait_for(lambda: sum("attach refused" in m.msg and m.level == Log.WARN for m in self.log[start:])
+                                 >= len(attaches) and sum("detach refused" in m.msg for m in self.log[start:]) >= 4, 10.0),
+                        [m.msg[:100] for m in self.log[start:]])
+        # Nothing was grasped: node 2 still hangs free (it moves), the first node still follows its frame.
+        self.state.next(5)
+        x = self.state.node("rope", 2)
+        self.assertTrue(wait_for(lambda: math.dist(self.state.node("rope", 2), x) > 1e-6, 10.0))
+        s = self.state.next(1)
+        first = s.bodies[0].positions[0]
+        self.assertLess(math.dist((first.x, first.y, first.z), gripper_position(s.header.stamp.to_sec())), 0.01)
+
+    def test_an_input_parameter_of_a_wrong_type_or_range_stops_the_node_naming_it(self):
+        node = roslib.packages.find_node("soft_body_sim", "soft_body_sim_node")[0]
+        scene = os.path.join(os.path.dirname(os.path.abspath(__file__)), "frame_test_scene.yaml")
+        cases = [  # (parameter, value, what the node says)
+            ("max_input_age", "abc", "max_input_age: must be a finite number of seconds > 0, not 'abc'"),
+            ("max_input_lead", "true", "max_input_lead: must be a finite number of seconds > 0, not true"),
+            ("max_input_age", "0", "max_input_age: must be a finite number of seconds > 0, not 0"),
+            ("max_input_lead", "-1.5", "max_input_lead: must be a finite number of seconds > 0, not -1.5"),
+            ("max_held_inputs", "0", "max_held_inputs: must be an integer >= 1, not 0"),
+            ("max_held_inputs", "2.5", "max_held_inputs: must be an integer >= 1, not 2.5"),
+        ]
+        for k, (parameter, value, message) in enumerate(cases):
+            name = f"bad_input_parameter_{k}"  # its own private namespace: no parameter left from the last
+            result = subprocess.run([node, f"__name:={name}", f"_scene:={scene}", f"_{parameter}:={value}"],
+                                    capture_output=True, text=True, timeout=60)
+            self.assertEqual(result.returncode, 1, result.stderr)
+            self.assertIn(f"/{name}/{message}", result.stderr)
 
 
 if __name__ == "__main__":

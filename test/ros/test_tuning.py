@@ -10,6 +10,8 @@ import dynamic_reconfigure.client
 import rospy
 import rostest
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from dynamic_reconfigure.msg import Config, DoubleParameter, StrParameter
+from dynamic_reconfigure.srv import Reconfigure
 from rosgraph_msgs.msg import Log
 from std_srvs.srv import Empty
 
@@ -107,6 +109,22 @@ class TuningTest(unittest.TestCase):
         dynparam("set", NODE + "/rope", "stiffness_scale", "0")
         self.assertEqual(self.rope.get_configuration(5)["stiffness_scale"], 1.0)
         self.state.next(5)  # still running
+
+    def test_a_nan_a_huge_or_an_unknown_request_changes_nothing(self):
+        # Straight to the service: dynparam cannot send NaN, and would refuse unknown names itself.
+        set_parameters = rospy.ServiceProxy(NODE + "/set_parameters", Reconfigure)
+        start = len(self.log)
+        answer = set_parameters(Config(doubles=[DoubleParameter("dt", float("nan"))]))
+        self.assertEqual({d.name: d.value for d in answer.config.doubles}["dt"], 0.001)
+        self.assertTrue(wait_for(lambda: any("dt = nan is out of range" in m.msg for m in self.log[start:]), 10.0))
+        # 100,000 unknown names and a 1 MB integrator name: answered, nothing applied, still running.
+        answer = set_parameters(Config(doubles=[DoubleParameter(f"unknown_{k}", float(k)) for k in range(100000)]))
+        self.assertEqual({d.name: d.value for d in answer.config.doubles}["dt"], 0.001)
+        answer = set_parameters(Config(strs=[StrParameter("integrator", "x" * 1000000)]))
+        self.assertEqual({s.name: s.value for s in answer.config.strs}["integrator"], "semi_implicit_euler")
+        config = get_config()
+        self.assertEqual({name: config[name] for name in SCENE_PHYSICS}, SCENE_PHYSICS)
+        self.state.next(5)
 
     def test_gravity_turned_upside_down_lifts_the_rope(self):
         dynparam("set", NODE, "gravity_z", "9.81")

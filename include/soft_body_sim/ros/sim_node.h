@@ -58,9 +58,14 @@ private:
   void buildWorldFromScene();
 
   // --- inputs (sim_node_inputs.cpp)
+  /// ~max_input_age [s], ~max_input_lead [s] and ~max_held_inputs (see InputLimits); throws, naming the
+  /// parameter, if one is set to a wrong type or out of range.
+  InputLimits readInputLimits() const;
+  /// Reads the input limits and subscribes to every anchor's pose topic and every target topic.
   void subscribeInputs();
   void addHandles();
-  /// Queues an input for the step its stamp falls in; stamp 0 means now.
+  /// Queues an input for the step its stamp falls in (stamp 0 means now), or drops it with a throttled
+  /// warning naming `topic` (stale, too far ahead); warns when its source was full.
   void schedule(const std::string& topic, const ros::Time& stamp, const ScheduledInput& input);
   void applyDueInputs(const ros::Time& step_end);
   /// The pose's position in the scene frame; false (with a throttled warning naming `topic` and the
