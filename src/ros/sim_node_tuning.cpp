@@ -58,7 +58,10 @@ std::string SimNode::applySimConfig(const SimConfig& config)
   if (!integratorFromName(config.integrator, integrator))
   {
     std::ostringstream why;
-    why << "integrator '" << config.integrator << "' is unknown; valid:";
+    // Quoted back only as far as a name could be: the request may hold megabytes.
+    const std::size_t shown = 32;
+    why << "integrator '" << config.integrator.substr(0, shown) << (config.integrator.size() > shown ? "...'" : "'")
+        << " is unknown; valid:";
     for (const std::string& name : integratorNames())
       why << " " << name;
     return why.str();
