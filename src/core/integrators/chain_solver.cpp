@@ -11,6 +11,10 @@ namespace soft_body_sim
 namespace
 {
 constexpr std::int64_t kNone = -1;
+
+/// A chain is solved directly only if its heaviest free node weighs at least this many times its
+/// lightest: the usual rule of thumb keeps iterative constraint solvers below a mass ratio of 10.
+constexpr double kMassRatio = 10.0;
 }  // namespace
 
 RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const Eigen::VectorXd& inverse_mass)
@@ -116,6 +120,22 @@ RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const E
         current = static_cast<std::int64_t>(r);
     if (current == kNone)
       continue;
+    // And only where Gauss-Seidel fails. It moves each node by its share w_i / (w_i + w_j) of a
+    // correction: an even chain takes its load within a few sweeps (every rope scene), a heavy node
+    // pulls through (hard case 2). Where rows turn fast the one linearised step is the less robust of
+    // the two: a 51-node even rope swinging at h = 10 ms stays finite with Gauss-Seidel and went to NaN
+    // with the direct solve.
+    double lightest = std::numeric_limits<double>::infinity();
+    double heaviest = 0.0;
+    for (const std::size_t r : component)
+      for (const int node : { ends[r].first, ends[r].second })
+        if (free(node))
+        {
+          lightest = std::min(lightest, 1.0 / inverse_mass[node]);
+          heaviest = std::max(heaviest, 1.0 / inverse_mass[node]);
+        }
+    if (heaviest < kMassRatio * lightest)
+      continue;
     std::int64_t previous = kNone;
     while (current != kNone)
     {
@@ -172,15 +192,21 @@ void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::Ve
     underestimated = underestimated || now > 2.0 * estimate_[i];
     estimate_[i] = std::max(estimate_[i], now);
   }
-  if (!underestimated)
-    return;
+  if (underestimated)
+  {
+    restart(rows, count, x, lambda);
+    newtonStep(rows, count, inverse_mass, x_prev, h, x, lambda);
+  }
+}
+
+void ChainSolver::restart(const SweepRow* rows, std::size_t count, NodeArray& x, double* lambda) const
+{
   for (std::size_t i = 0; i < count; ++i)
   {
     x.col(rows[i].a) = start_a_.col(static_cast<Eigen::Index>(i));
     x.col(rows[i].b) = start_b_.col(static_cast<Eigen::Index>(i));
     lambda[i] = start_lambda_[i];
   }
-  newtonStep(rows, count, inverse_mass, x_prev, h, x, lambda);
 }
 
 void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,

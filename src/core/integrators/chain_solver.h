@@ -18,10 +18,11 @@ namespace soft_body_sim
 /// rows so coupled form no cycle, each connected set of rows is a path, and in path order its matrix is
 /// tridiagonal. If the path also ends in a free node (a chain hanging from at most one support, or
 /// none), its rows are independent in any shape, and the system is solved exactly in O(n) by the
-/// Thomas algorithm, with no fill-in (Deul, Kugelstadt,
-/// Weiler, Bender 2018, "Direct Position-Based Solver for Stiff Rods": tree-structured systems; a path
-/// is the simplest tree). Gauss-Seidel, which moves the end of a chain by w_end / (w_end + w_next) of
-/// each correction, cannot carry a heavy end mass; the direct solve does at any mass ratio.
+/// Thomas algorithm, with no fill-in (Deul, Kugelstadt, Weiler, Bender 2018, "Direct Position-Based
+/// Solver for Stiff Rods": tree-structured systems; a path is the simplest tree). Gauss-Seidel, which moves the end of a chain by w_end / (w_end + w_next) of
+/// each correction, cannot carry a heavy end mass; the direct solve does at any mass ratio. It is used
+/// where that is needed, on chains whose masses differ by a factor of 10 or more; even chains, whose
+/// load Gauss-Seidel carries, keep its sweep and its robustness to rows turning fast.
 struct RowPartition
 {
   std::vector<std::uint32_t> swept;        ///< rows left to Gauss-Seidel, in model order
@@ -30,9 +31,9 @@ struct RowPartition
 };
 
 /// Splits rows (given by their end nodes, ends[r] = {a, b}) into chains of two or more rows with a free
-/// end, each listed from that end, and the rest. A chain of one row is left to the sweep: for a single
-/// row the Gauss-Seidel update is the exact solve.
-/// Depends on which nodes are free: recompute it when a node is pinned or released.
+/// end and a mass ratio of 10 or more, each listed from that end, and the rest. A chain of one row is
+/// left to the sweep: for a single row the Gauss-Seidel update is the exact solve. Depends on which
+/// nodes are free: recompute it when a node is pinned or released.
 RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const Eigen::VectorXd& inverse_mass);
 
 /// One Newton step of XPBD on a chain, with the chain's geometric stiffness.
@@ -80,6 +81,9 @@ private:
   /// The step itself, with the geometric stiffness of the tensions in estimate_.
   void newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
                   double h, NodeArray& x, double* lambda);
+
+  /// Puts the chain's nodes and lambdas back where solve() found them.
+  void restart(const SweepRow* rows, std::size_t count, NodeArray& x, double* lambda) const;
 
   /// W~ at `node`, one of the nodes of row i.
   Matrix3 mobility(const SweepRow* rows, std::size_t count, std::size_t i, int node,
