@@ -88,8 +88,8 @@ long allocationsOf(Action&& action)
   return g_allocations;
 }
 
-/// Every body type side by side above a floor, with anchors on the rope and the cloth and inextensible
-/// constraints along the rope, so that a step runs every stage and every kernel.
+/// Every body type side by side above a floor, with anchors on the rope and the cloth, inextensible
+/// constraints along the rope and a heavy-ended chain, so that a step runs every stage and every kernel.
 SceneDef everyFeatureScene(IntegratorType integrator)
 {
   SceneDef scene;
@@ -114,6 +114,15 @@ SceneDef everyFeatureScene(IntegratorType integrator)
     rope_body.constraints.push_back(ConstraintDef{ i, i + 1, 1e-4, std::nullopt });
   rope_body.anchors = { AnchorDef{ "left", 0 }, AnchorDef{ "right", rope.nodes - 1 } };
   scene.bodies.push_back(rope_body);
+
+  // A chain with an end mass 100 times its nodes': xpbd solves it directly (chain_solver.h).
+  BodyDef chain;
+  chain.name = "chain";
+  for (int i = 0; i < 6; ++i)
+    chain.nodes.push_back(NodeDef{ Vec3(-3.0, 0.0, 2.0 - 0.1 * i), i == 5 ? 1.0 : 0.01, Vec3::Zero(), i == 0 });
+  for (int i = 0; i + 1 < 6; ++i)
+    chain.springs.push_back(SpringDef{ i, i + 1, 1e4, 0.1, std::nullopt });
+  scene.bodies.push_back(chain);
 
   ClothDef cloth;
   cloth.nx = 6;

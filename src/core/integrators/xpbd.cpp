@@ -1,7 +1,9 @@
+#include <algorithm>
 #include <cstdint>
 #include <utility>
 #include <vector>
 
+#include "chain_solver.h"
 #include "integrator_kit.h"
 #include "soft_body_sim/core/forces.h"
 
@@ -44,9 +46,10 @@ void solveCell(const PressureCell& cell, const Eigen::VectorXd& inverse_mass, do
 ///   preSolve:  v = v / (1 + h drag) + h g,  x_prev = x,  x += h v
 ///              (drag implicit on the carried velocity only, so it stays stable for any h drag and
 ///              cannot scale gravity down at rest, where the constraints cancel h g every sub-step)
-///   solve:     `iterations` Gauss-Seidel sweeps over springs (compliance 1/k, damping c),
+///   solve:     `iterations` block Gauss-Seidel sweeps over springs (compliance 1/k, damping c),
 ///              distance constraints (their own compliance) and pressure cells (see solveCell),
-///              lambda accumulated per sub-step
+///              lambda accumulated per sub-step. Rows that form chains (partitionRows) are solved
+///              together and exactly, one Newton step per sweep (chain_solver.h); the others one by one
 ///   postSolve: v = (x - x_prev) / h
 class Xpbd final : public Integrator
 {
@@ -79,11 +82,12 @@ private:
 
   void solve(const Model& model, NodeArray& x, double h, int iterations)
   {
-    const std::size_t spring_count = model.springs.size();
-    const std::size_t row_count = spring_count + model.constraints.size();
-    if (order_.size() != row_count || coloured_nodes_ != model.nodeCount())
+    const std::size_t row_count = model.springs.size() + model.constraints.size();
+    // The partition into chains depends on which nodes are pinned: checked whenever the rows are stale
+    // (invalidate() follows World::attach and detach).
+    if (order_.size() != row_count || ordered_nodes_ != model.nodeCount() || (h != rows_h_ && pinningChanged(model)))
     {
-      colourRows(model);
+      orderRows(model);
       rows_h_ = 0.0;
     }
     rows_.resize(row_count);  // sized once: no allocation after the first sub-step
@@ -94,76 +98,122 @@ private:
       if (iteration == 0 && h != rows_h_)
       {
         // Rows are stale (new h, or invalidate(): the model may have been retuned): the first sweep
-        // writes them as it goes.
+        // writes them as it goes, then the chains' rows are written.
         const double inverse_h2 = 1.0 / (h * h);
-        for (std::size_t k = 0; k < row_count; ++k)
+        for (std::size_t k = 0; k < swept_count_; ++k)
         {
-          const std::size_t r = order_[k];
-          ConstraintRow row;
-          if (r < spring_count)
-          {
-            const Spring& s = model.springs[r];
-            const double alpha_tilde = inverse_h2 / s.stiffness;
-            row = ConstraintRow{ s.a, s.b, s.rest_length, alpha_tilde, alpha_tilde * s.damping * h };
-          }
-          else
-          {
-            const DistanceConstraint& c = model.constraints[r - spring_count];
-            row = ConstraintRow{ c.a, c.b, c.rest_length, c.compliance * inverse_h2, 0.0 };
-          }
-          rows_[k] = sweepRow(row, model.inverse_mass);
+          rows_[k] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
           projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
         }
+        for (std::size_t k = swept_count_; k < row_count; ++k)
+          rows_[k] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
         rows_h_ = h;
       }
       else
       {
-        for (std::size_t k = 0; k < row_count; ++k)
+        for (std::size_t k = 0; k < swept_count_; ++k)
           projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
       }
+      // Chains share no free node with the swept rows: each is one block of a block Gauss-Seidel, solved
+      // exactly (one Newton step per iteration).
+      for (std::size_t c = 0; c + 1 < chain_starts_.size(); ++c)
+        chains_.solve(&rows_[chain_starts_[c]], chain_starts_[c + 1] - chain_starts_[c], model.inverse_mass, previous_,
+                      h, chain_tension_.data() + chain_starts_[c], x, lambda_.data() + chain_starts_[c]);
       for (std::size_t k = 0; k < model.cells.size(); ++k)
         solveCell(model.cells[k], model.inverse_mass, h, x, cell_lambda_[static_cast<Eigen::Index>(k)]);
     }
+    // The chains' tensions T = -lambda / h^2 [N] (lambda < 0 pulls the ends together), for the next
+    // sub-step's geometric stiffness; compression adds none.
+    const double inverse_h2 = 1.0 / (h * h);
+    for (std::size_t k = swept_count_; k < row_count; ++k)
+      chain_tension_[static_cast<Eigen::Index>(k)] = std::max(0.0, -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2);
   }
 
-  /// The sweep order: springs and constraints (row r < springs.size() is spring r, the others the
-  /// constraints in turn) grouped by a greedy edge colouring, so that no two rows of a colour share a
-  /// node. In model order, consecutive rows of a rope or a cloth row share a node, so each update waits
-  /// for its predecessor's square root and divisions (~90 cycles); within a colour the processor
-  /// overlaps them. Gauss-Seidel in this order converges as fast as in model order (both are
-  /// consistent orderings; for a chain, red-black and lexicographic have the same spectral radius).
-  void colourRows(const Model& model)
+  /// Row r of the solve: spring r (compliance 1 / k, damping c) for r < springs.size(), else a distance
+  /// constraint.
+  static ConstraintRow constraintRow(const Model& model, std::size_t r, double h, double inverse_h2)
+  {
+    if (r < model.springs.size())
+    {
+      const Spring& s = model.springs[r];
+      const double alpha_tilde = inverse_h2 / s.stiffness;
+      return ConstraintRow{ s.a, s.b, s.rest_length, alpha_tilde, alpha_tilde * s.damping * h };
+    }
+    const DistanceConstraint& c = model.constraints[r - model.springs.size()];
+    return ConstraintRow{ c.a, c.b, c.rest_length, c.compliance * inverse_h2, 0.0 };
+  }
+
+  bool pinningChanged(const Model& model) const
+  {
+    for (int i = 0; i < model.nodeCount(); ++i)
+      if (free_[static_cast<std::size_t>(i)] != static_cast<std::uint8_t>(model.isFree(i)))
+        return true;
+    return false;
+  }
+
+  /// The solve order: the rows swept by Gauss-Seidel (see colourRows), then the chains (see
+  /// partitionRows), each in path order.
+  void orderRows(const Model& model)
   {
     const std::size_t spring_count = model.springs.size();
-    const std::size_t row_count = spring_count + model.constraints.size();
-    const auto ends = [&](std::size_t r) {
-      return r < spring_count ? std::pair<int, int>(model.springs[r].a, model.springs[r].b)
-                              : std::pair<int, int>(model.constraints[r - spring_count].a,
-                                                    model.constraints[r - spring_count].b);
-    };
+    std::vector<std::pair<int, int>> ends;
+    ends.reserve(spring_count + model.constraints.size());
+    for (const Spring& s : model.springs)
+      ends.emplace_back(s.a, s.b);
+    for (const DistanceConstraint& c : model.constraints)
+      ends.emplace_back(c.a, c.b);
+    const RowPartition partition = partitionRows(ends, model.inverse_mass);
+    order_.clear();
+    colourRows(model, ends, partition.swept);
+    swept_count_ = order_.size();
+    order_.insert(order_.end(), partition.chain_rows.begin(), partition.chain_rows.end());
+    chain_starts_.clear();
+    std::size_t longest = 0;
+    for (std::size_t c = 0; c < partition.chain_starts.size(); ++c)
+    {
+      chain_starts_.push_back(swept_count_ + partition.chain_starts[c]);
+      if (c > 0)
+        longest = std::max<std::size_t>(longest, partition.chain_starts[c] - partition.chain_starts[c - 1]);
+    }
+    chains_.reserve(longest);
+    chain_tension_.setZero(static_cast<Eigen::Index>(order_.size()));
+    free_.resize(static_cast<std::size_t>(model.nodeCount()));
+    for (int i = 0; i < model.nodeCount(); ++i)
+      free_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(model.isFree(i));
+    ordered_nodes_ = model.nodeCount();
+  }
+
+  /// Appends `rows` (row indices, in model order) to order_ grouped by a greedy edge colouring, so that
+  /// no two rows of a colour share a node. In model order, consecutive rows of a rope or a cloth row
+  /// share a node, so each update waits for its predecessor's square root and divisions (~90 cycles);
+  /// within a colour the processor overlaps them. Gauss-Seidel in this order converges as fast as in
+  /// model order (both are consistent orderings; for a chain, red-black and lexicographic have the same
+  /// spectral radius).
+  void colourRows(const Model& model, const std::vector<std::pair<int, int>>& ends,
+                  const std::vector<std::uint32_t>& rows)
+  {
     constexpr int kColours = 64;
     std::vector<std::uint64_t> used(static_cast<std::size_t>(model.nodeCount()), 0);
-    std::vector<std::uint8_t> colour(row_count);
+    std::vector<std::uint8_t> colour(rows.size());
     std::size_t start[kColours + 1] = {};
-    for (std::size_t r = 0; r < row_count; ++r)
+    for (std::size_t k = 0; k < rows.size(); ++k)
     {
-      const auto [a, b] = ends(r);
+      const auto [a, b] = ends[rows[k]];
       const std::uint64_t taken = used[static_cast<std::size_t>(a)] | used[static_cast<std::size_t>(b)];
       // The first free colour; a node with 64 rows shares the last one (still correct, only slower).
       int c = 0;
       while (c < kColours - 1 && (taken >> c) & 1u)
         ++c;
-      colour[r] = static_cast<std::uint8_t>(c);
+      colour[k] = static_cast<std::uint8_t>(c);
       used[static_cast<std::size_t>(a)] |= std::uint64_t{ 1 } << c;
       used[static_cast<std::size_t>(b)] |= std::uint64_t{ 1 } << c;
       ++start[c + 1];
     }
     for (int c = 0; c < kColours; ++c)
       start[c + 1] += start[c];
-    order_.resize(row_count);
-    for (std::size_t r = 0; r < row_count; ++r)
-      order_[start[colour[r]]++] = static_cast<std::uint32_t>(r);
-    coloured_nodes_ = model.nodeCount();
+    order_.resize(rows.size());
+    for (std::size_t k = 0; k < rows.size(); ++k)
+      order_[start[colour[k]]++] = rows[k];
   }
 
   void postSolve(const Model& model, State& state, double h)
@@ -176,9 +226,14 @@ private:
   }
 
   NodeArray previous_;
-  std::vector<std::uint32_t> order_;  ///< sweep order of the rows (see colourRows)
-  int coloured_nodes_ = -1;
-  std::vector<SweepRow> rows_;        ///< the rows in sweep order, valid for h = rows_h_
+  std::vector<std::uint32_t> order_;  ///< solve order of the rows (see orderRows)
+  std::size_t swept_count_ = 0;       ///< order_[0, swept_count_) are swept by Gauss-Seidel
+  std::vector<std::size_t> chain_starts_;  ///< chain c is order_[chain_starts_[c], chain_starts_[c + 1])
+  std::vector<std::uint8_t> free_;    ///< per node: free when the rows were ordered
+  int ordered_nodes_ = -1;
+  ChainSolver chains_;
+  Eigen::VectorXd chain_tension_;     ///< [N] per row in solve order: the chains' tensions at the last sub-step
+  std::vector<SweepRow> rows_;        ///< the rows in solve order, valid for h = rows_h_
   double rows_h_ = 0.0;               ///< [s]; 0 = rows not built
   Eigen::VectorXd lambda_;
   Eigen::VectorXd cell_lambda_;

@@ -1,0 +1,324 @@
+#include "chain_solver.h"
+
+#include <algorithm>
+#include <array>
+#include <limits>
+
+#include <Eigen/LU>
+
+namespace soft_body_sim
+{
+namespace
+{
+constexpr std::int64_t kNone = -1;
+
+/// A chain is solved directly only if its heaviest free node weighs at least this many times its
+/// lightest: the usual rule of thumb keeps iterative constraint solvers below a mass ratio of 10.
+constexpr double kMassRatio = 10.0;
+}  // namespace
+
+RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const Eigen::VectorXd& inverse_mass)
+{
+  const std::size_t row_count = ends.size();
+  const auto free = [&](int node) { return inverse_mass[node] > 0.0; };
+  // Per node: how many rows meet there, and the first two of them.
+  std::vector<int> degree(static_cast<std::size_t>(inverse_mass.size()), 0);
+  std::vector<std::array<std::int64_t, 2>> meeting(degree.size(), { kNone, kNone });
+  for (std::size_t r = 0; r < row_count; ++r)
+  {
+    const auto [a, b] = ends[r];
+    if (a == b)
+      continue;
+    for (const int node : { a, b })
+    {
+      int& d = degree[static_cast<std::size_t>(node)];
+      if (d < 2)
+        meeting[static_cast<std::size_t>(node)][static_cast<std::size_t>(d)] = static_cast<std::int64_t>(r);
+      ++d;
+    }
+  }
+  // Each row's neighbours: the other row at each free end where exactly two meet. A row at a free node
+  // where three or more meet (a branch), or with both ends on one node, makes its set of rows no chain.
+  std::vector<std::array<std::int64_t, 2>> neighbours(row_count, { kNone, kNone });
+  std::vector<std::uint8_t> branching(row_count, 0);
+  for (std::size_t r = 0; r < row_count; ++r)
+  {
+    const auto [a, b] = ends[r];
+    if (a == b)
+    {
+      branching[r] = 1;
+      continue;
+    }
+    int slot = 0;
+    for (const int node : { a, b })
+    {
+      const std::size_t n = static_cast<std::size_t>(node);
+      if (!free(node) || degree[n] < 2)
+        continue;
+      if (degree[n] > 2)
+      {
+        branching[r] = 1;
+        continue;
+      }
+      const std::int64_t self = static_cast<std::int64_t>(r);
+      neighbours[r][static_cast<std::size_t>(slot++)] = meeting[n][0] == self ? meeting[n][1] : meeting[n][0];
+    }
+  }
+  // Each connected set of rows: a chain if nothing branches, it has two or more rows and it has one link
+  // fewer than rows (with at most two links per row, the connected graphs without a cycle are paths;
+  // two rows on the same two free nodes count as two links, a cycle), and one of its two end rows ends
+  // in a free node of its own. Without such a free end (pinned at both ends), a straight chain's rows
+  // are linearly dependent and an inextensible one's system singular: a taut or compressed chain
+  // between two supports can only leave the line to second order, which the linearised solve cannot
+  // see, so such chains stay with Gauss-Seidel's nonlinear projections.
+  RowPartition partition;
+  partition.chain_starts.push_back(0);
+  std::vector<std::uint8_t> visited(row_count, 0);
+  std::vector<std::uint8_t> in_chain(row_count, 0);
+  std::vector<std::size_t> component;
+  const auto freeEnd = [&](std::size_t r) {
+    // An end row's node that no other row shares, if free.
+    for (const int node : { ends[r].first, ends[r].second })
+      if (free(node) && degree[static_cast<std::size_t>(node)] == 1)
+        return true;
+    return false;
+  };
+  for (std::size_t start = 0; start < row_count; ++start)
+  {
+    if (visited[start])
+      continue;
+    component.assign(1, start);
+    visited[start] = 1;
+    std::size_t links = 0;
+    bool branches = false;
+    for (std::size_t k = 0; k < component.size(); ++k)
+    {
+      const std::size_t r = component[k];
+      branches = branches || branching[r];
+      for (const std::int64_t next : neighbours[r])
+      {
+        if (next == kNone)
+          continue;
+        ++links;
+        if (!visited[static_cast<std::size_t>(next)])
+        {
+          visited[static_cast<std::size_t>(next)] = 1;
+          component.push_back(static_cast<std::size_t>(next));
+        }
+      }
+    }
+    if (branches || component.size() < 2 || links != 2 * (component.size() - 1))
+      continue;
+    // Walk the path from its free end: eliminating from there, each pivot of the Thomas algorithm in a
+    // straight chain is at least the inverse mass of its row's node toward the support, with no
+    // cancellation against a lighter neighbour (from the support, the last pivot is
+    // w_end = (w_next + w_end) - w_next, which loses w_next / w_end of its digits: all of them at a mass
+    // ratio of 1e16).
+    std::int64_t current = kNone;
+    for (const std::size_t r : component)
+      if (neighbours[r][1] == kNone && freeEnd(r))
+        current = static_cast<std::int64_t>(r);
+    if (current == kNone)
+      continue;
+    // And only where Gauss-Seidel fails. It moves each node by its share w_i / (w_i + w_j) of a
+    // correction: an even chain takes its load within a few sweeps (every rope scene), a heavy node
+    // pulls through (hard case 2). Where rows turn fast the one linearised step is the less robust of
+    // the two: a 51-node even rope swinging at h = 10 ms stays finite with Gauss-Seidel and went to NaN
+    // with the direct solve.
+    double lightest = std::numeric_limits<double>::infinity();
+    double heaviest = 0.0;
+    for (const std::size_t r : component)
+      for (const int node : { ends[r].first, ends[r].second })
+        if (free(node))
+        {
+          lightest = std::min(lightest, 1.0 / inverse_mass[node]);
+          heaviest = std::max(heaviest, 1.0 / inverse_mass[node]);
+        }
+    if (heaviest < kMassRatio * lightest)
+      continue;
+    std::int64_t previous = kNone;
+    while (current != kNone)
+    {
+      const std::size_t r = static_cast<std::size_t>(current);
+      partition.chain_rows.push_back(static_cast<std::uint32_t>(r));
+      in_chain[r] = 1;
+      const std::int64_t next = neighbours[r][0] != previous ? neighbours[r][0] : neighbours[r][1];
+      previous = current;
+      current = next;
+    }
+    partition.chain_starts.push_back(static_cast<std::uint32_t>(partition.chain_rows.size()));
+  }
+  for (std::size_t r = 0; r < row_count; ++r)
+    if (!in_chain[r])
+      partition.swept.push_back(static_cast<std::uint32_t>(r));
+  return partition;
+}
+
+void ChainSolver::reserve(std::size_t rows)
+{
+  const Eigen::Index n = static_cast<Eigen::Index>(rows);
+  start_a_.resize(3, n);
+  start_b_.resize(3, n);
+  start_lambda_.resize(rows);
+  estimate_.resize(rows);
+  direction_.resize(3, n);
+  geometric_.resize(rows);
+  mobility_a_.resize(rows);
+  mobility_b_.resize(rows);
+  diagonal_.resize(rows);
+  coupling_.resize(rows);
+  rhs_.resize(rows);
+  upper_.resize(rows);
+  delta_.resize(rows);
+}
+
+void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
+                        const NodeArray& x_prev, double h, const double* tension, NodeArray& x, double* lambda)
+{
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    start_a_.col(static_cast<Eigen::Index>(i)) = x.col(rows[i].a);
+    start_b_.col(static_cast<Eigen::Index>(i)) = x.col(rows[i].b);
+    start_lambda_[i] = lambda[i];
+    estimate_[i] = tension[i];
+  }
+  newtonStep(rows, count, inverse_mass, x_prev, h, x, lambda);
+  // This sub-step's tension -lambda / h^2 against the estimate its geometric stiffness used.
+  const double inverse_h2 = 1.0 / (h * h);
+  bool underestimated = false;
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const double now = -lambda[i] * inverse_h2;
+    underestimated = underestimated || now > 2.0 * estimate_[i];
+    estimate_[i] = std::max(estimate_[i], now);
+  }
+  if (underestimated)
+  {
+    restart(rows, count, x, lambda);
+    newtonStep(rows, count, inverse_mass, x_prev, h, x, lambda);
+  }
+}
+
+void ChainSolver::restart(const SweepRow* rows, std::size_t count, NodeArray& x, double* lambda) const
+{
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    x.col(rows[i].a) = start_a_.col(static_cast<Eigen::Index>(i));
+    x.col(rows[i].b) = start_b_.col(static_cast<Eigen::Index>(i));
+    lambda[i] = start_lambda_[i];
+  }
+}
+
+void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
+                             const NodeArray& x_prev, double h, NodeArray& x, double* lambda)
+{
+  // Each row at the current positions (as projectDistance, but every row at the same x): its direction,
+  // its right-hand side -C - alpha~ lambda - gamma u . ((x_a - x_prev_a) - (x_b - x_prev_b)), and its
+  // lumped geometric stiffness 2 h^2 T / l [kg] (see the class comment).
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const SweepRow& row = rows[i];
+    const Eigen::Index column = static_cast<Eigen::Index>(i);
+    direction_.col(column).setZero();
+    rhs_[i] = 0.0;
+    geometric_[i] = 0.0;
+    if (row.inverse_denominator == 0.0)
+      continue;  // both ends pinned: dlambda = 0
+    const Vec3 d = x.col(row.a) - x.col(row.b);
+    const double length = d.norm();
+    if (length < kMinSpringLength)
+      continue;  // coincident nodes: the direction is undefined
+    const Vec3 u = d * (1.0 / length);
+    direction_.col(column) = u;
+    const double c_rate_h =
+        row.gamma == 0.0 ? 0.0 : u.dot((x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b)));
+    rhs_[i] = -(length - row.rest_length) - row.alpha_tilde * lambda[i] - row.gamma * c_rate_h;
+    geometric_[i] = 2.0 * h * h * estimate_[i] / length;
+  }
+  // The mobility W~ = M~^-1 at each row's two nodes (zero at a pinned one). A free node of a chain meets
+  // at most two rows, consecutive ones: the node row i shares with row i - 1 has that row's mobility.
+  int shared_before = -1;
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const SweepRow& row = rows[i];
+    const auto before = [&]() -> const Matrix3& {
+      return rows[i - 1].a == shared_before ? mobility_a_[i - 1] : mobility_b_[i - 1];
+    };
+    mobility_a_[i] = row.a == shared_before ? before() : mobility(rows, count, i, row.a, inverse_mass);
+    mobility_b_[i] = row.b == shared_before ? before() : mobility(rows, count, i, row.b, inverse_mass);
+    if (i + 1 < count)
+      shared_before = row.a == rows[i + 1].a || row.a == rows[i + 1].b ? row.a : row.b;
+  }
+  // The system with row i divided by 1 + gamma_i, symmetric positive definite and tridiagonal:
+  //   diagonal_i = u_i . (W~_a + W~_b) u_i + alpha~_i / (1 + gamma_i),
+  //   coupling_i = (+-u_i) . W~_s (+-u_{i+1}) for the node s rows i and i + 1 share, the signs those of
+  //   gradC at s (+u at a row's node a, -u at its node b); zero next to a row that cannot move.
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const SweepRow& row = rows[i];
+    const Vec3 u = direction_.col(static_cast<Eigen::Index>(i));
+    const double scale = 1.0 / (1.0 + row.gamma);
+    diagonal_[i] = u.isZero(0.0) ? 1.0 : u.dot((mobility_a_[i] + mobility_b_[i]) * u) + row.alpha_tilde * scale;
+    rhs_[i] *= scale;
+    if (i + 1 == count)
+      continue;
+    const SweepRow& next = rows[i + 1];
+    const bool at_a = row.a == next.a || row.a == next.b;
+    const double sign = (at_a ? 1.0 : -1.0) * ((at_a ? row.a : row.b) == next.a ? 1.0 : -1.0);
+    const Matrix3& shared = at_a ? mobility_a_[i] : mobility_b_[i];
+    coupling_[i] = sign * u.dot(shared * direction_.col(static_cast<Eigen::Index>(i + 1)));
+  }
+  // Thomas algorithm (LDL^T of a tridiagonal matrix): for a symmetric positive definite matrix it is
+  // stable without pivoting and every pivot is positive. With a free end the rows are independent, so a
+  // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); one within the
+  // round-off of the subtraction that made it is treated as zero: its row keeps dlambda = 0 and the
+  // others are solved without it, rather than divided by noise.
+  constexpr double kPivotFloor = 64.0 * std::numeric_limits<double>::epsilon();
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const double lower = i > 0 ? coupling_[i - 1] : 0.0;
+    const double pivot = i > 0 ? diagonal_[i] - lower * upper_[i - 1] : diagonal_[i];
+    if (!(pivot > kPivotFloor * diagonal_[i]))
+    {
+      upper_[i] = 0.0;
+      delta_[i] = 0.0;
+      continue;
+    }
+    const double inverse_pivot = 1.0 / pivot;
+    upper_[i] = i + 1 < count ? coupling_[i] * inverse_pivot : 0.0;
+    delta_[i] = (rhs_[i] - (i > 0 ? lower * delta_[i - 1] : 0.0)) * inverse_pivot;
+  }
+  for (std::size_t i = count - 1; i-- > 0;)
+    delta_[i] -= upper_[i] * delta_[i + 1];
+  // x += W~ J^T dlambda, row by row.
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const SweepRow& row = rows[i];
+    const Vec3 u = direction_.col(static_cast<Eigen::Index>(i));
+    lambda[i] += delta_[i];
+    x.col(row.a) += mobility_a_[i] * (delta_[i] * u);
+    x.col(row.b) -= mobility_b_[i] * (delta_[i] * u);
+  }
+}
+
+ChainSolver::Matrix3 ChainSolver::mobility(const SweepRow* rows, std::size_t count, std::size_t i, int node,
+                                           const Eigen::VectorXd& inverse_mass) const
+{
+  const double w = inverse_mass[node];
+  if (w == 0.0)
+    return Matrix3::Zero();
+  Matrix3 inertia = (1.0 / w) * Matrix3::Identity();
+  bool stiffened = false;
+  for (std::size_t k = i > 0 ? i - 1 : 0; k <= i + 1 && k < count; ++k)
+  {
+    if (geometric_[k] == 0.0 || (k != i && rows[k].a != node && rows[k].b != node))
+      continue;
+    const Vec3 u = direction_.col(static_cast<Eigen::Index>(k));
+    inertia += geometric_[k] * (Matrix3::Identity() - u * u.transpose());
+    stiffened = true;
+  }
+  // Without tension M~ = m I: w I exactly, as the Gauss-Seidel update uses.
+  return stiffened ? Matrix3(inertia.inverse()) : Matrix3(w * Matrix3::Identity());
+}
+
+}  // namespace soft_body_sim
