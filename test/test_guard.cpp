@@ -183,7 +183,7 @@ TEST(Guard, FreezeStopsTheBodyWhileAnotherFallsOnItsExactParabola)
 
 TEST(Guard, ANonFiniteOrRunawayNodeSetFromOutsideIsPutBackToTheLastSavedGoodState)
 {
-  World world = buildWorld(scene(IntegratorType::Xpbd, 0.01, GuardPolicy::SwitchIntegrator,
+  World world = buildWorld(scene(IntegratorType::ImplicitEuler, 0.01, GuardPolicy::SwitchIntegrator,
                                  { ball("a"), ball("b") }));
   const State good = world.state();  // saved at step 0; the next save is at step kGuardCheckpointSteps
   world.step();
@@ -196,11 +196,11 @@ TEST(Guard, ANonFiniteOrRunawayNodeSetFromOutsideIsPutBackToTheLastSavedGoodStat
   std::vector<DivergenceEvent> events = world.takeDivergenceEvents();
   ASSERT_EQ(events.size(), 1u);
   EXPECT_EQ(events[0].reason, "node 0 is not finite");
-  // xpbd is stable at any step: nothing stabler to switch to, so the body is frozen.
-  EXPECT_EQ(events[0].action, "already on xpbd, stable at any step: frozen (its free nodes pinned at rest)");
+  // Already on implicit_euler: nothing stabler to switch to, so the body is frozen.
+  EXPECT_EQ(events[0].action, "already on implicit_euler: frozen (its free nodes pinned at rest)");
   EXPECT_TRUE(world.isFrozen(0));
   EXPECT_EQ(events[0].describe(), "body 'a' diverged at t = 0.020 s (node 0 is not finite): restored to its last "
-                                  "good state, already on xpbd, stable at any step: frozen (its free nodes pinned at rest)");
+                                  "good state, already on implicit_euler: frozen (its free nodes pinned at rest)");
 
   // Faster than max_speed: caught as well (body b, still free).
   GuardSettings guard;
@@ -213,6 +213,18 @@ TEST(Guard, ANonFiniteOrRunawayNodeSetFromOutsideIsPutBackToTheLastSavedGoodStat
   EXPECT_EQ(events[0].body, "b");
   EXPECT_EQ(events[0].reason, "node 0 moves at 101 m/s > max_speed 100 m/s");
   EXPECT_TRUE(world.takeDivergenceEvents().empty());
+}
+
+TEST(Guard, AnXpbdBodyIsSwitchedToImplicitEuler)
+{
+  World world = buildWorld(scene(IntegratorType::Xpbd, 0.01, GuardPolicy::SwitchIntegrator, { ball("a") }));
+  world.setNode(0, world.state().position.col(0), Vec3(std::numeric_limits<double>::infinity(), 0, 0));
+  world.step();
+  const std::vector<DivergenceEvent> events = world.takeDivergenceEvents();
+  ASSERT_EQ(events.size(), 1u);
+  EXPECT_EQ(events[0].action, "switched from xpbd to implicit_euler");
+  EXPECT_EQ(world.bodyIntegrator(0), IntegratorType::ImplicitEuler);
+  EXPECT_FALSE(world.isFrozen(0));
 }
 
 TEST(Guard, RejectsANonPositiveOrNonFiniteMaxSpeed)

@@ -234,8 +234,8 @@ std::string World::treatDiverged(std::size_t body)
         return text;
       }
     case GuardPolicy::SwitchIntegrator:
-      if (type == IntegratorType::ImplicitEuler || type == IntegratorType::Xpbd)
-        return "already on " + integratorName(type) + ", stable at any step: " + freeze(body);
+      if (type == IntegratorType::ImplicitEuler)
+        return "already on implicit_euler: " + freeze(body);
       body_integrator_[body] = IntegratorType::ImplicitEuler;
       groups_dirty_ = true;
       return "switched from " + integratorName(type) + " to implicit_euler";

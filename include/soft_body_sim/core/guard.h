@@ -16,8 +16,9 @@ enum class GuardPolicy
   /// kGuardMaxSubsteps the body is frozen instead: a scheme that diverges at any step (explicit Euler
   /// on an undamped spring) is not helped by a smaller one.
   HalveStep,
-  /// Step that body with implicit_euler from now on (the others keep theirs). A body already on
-  /// implicit_euler or xpbd, both stable at any step, is frozen instead.
+  /// Step that body with implicit_euler from now on (the others keep theirs): unconditionally stable for
+  /// springs, and the one scheme here without a step limit of its own (xpbd's direct chain solve has
+  /// one). A body already on implicit_euler is frozen instead.
   SwitchIntegrator,
   /// Pin the body's free nodes where they are, at rest. The rest of the scene goes on.
   Freeze,
