@@ -750,6 +750,15 @@ bodies: []
   - name: c
 )",
     "bad.yaml:4:3", { "invalid YAML", "illegal block entry" } },
+  // yaml-cpp 0.7's LoadAll loops on these, collecting empty documents until memory runs out.
+  { "StrayCommaAtTopLevel", R"(,
+)",
+    "bad.yaml:1:1", { "invalid YAML", "unexpected ','" } },
+  { "StrayCommaAfterTheScene", R"(bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+---
+,
+)",
+    "bad.yaml:3:1", { "invalid YAML", "unexpected ','" } },
   { "TopLevelIsAList", R"(- name: b
   type: custom
 )",

@@ -194,22 +194,7 @@ SceneDef loadSceneFile(const std::string& path)
 SceneDef parseScene(const std::string& yaml_text, const std::string& source)
 {
   const Context ctx(source);
-  std::vector<YAML::Node> documents;
-  try
-  {
-    // All documents, not just the first: a second one would otherwise be silently ignored.
-    documents = YAML::LoadAll(yaml_text);
-  }
-  catch (const YAML::ParserException& e)
-  {
-    throw SceneError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                     ": invalid YAML: " + e.msg);
-  }
-  // A trailing "---" (an empty document) holds nothing that could be ignored; any other one would be.
-  for (std::size_t i = 1; i < documents.size(); ++i)
-    if (!documents[i].IsNull())
-      ctx.fail(documents[i].Mark(), "", "found a second YAML document; a scene file holds exactly one");
-  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+  const YAML::Node root = loadSingleDocument(ctx, yaml_text);
   return readScene(ctx, Field{ root, "", root.Mark() });
 }
 
