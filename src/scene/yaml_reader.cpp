@@ -57,10 +57,11 @@ private:
   }
 };
 
+/// `reason` may quote the input (yaml-cpp's "unknown escape character: <the character>"): it is made printable.
 [[noreturn]] void failInvalid(const Context& ctx, const YAML::Mark& mark, const std::string& reason)
 {
   throw SceneError(ctx.source() + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1) +
-                   ": invalid YAML: " + reason);
+                   ": invalid YAML: " + printable(reason));
 }
 }  // namespace
 
