@@ -765,6 +765,12 @@ bodies: []
     "bad.yaml:4: bodies[0].nodes", { "must not be empty" } },
 
   // --- the document itself
+  { "MergeKey", R"(bodies:
+  - &rope {name: a, type: rope, nodes: 8, from: [0, 0, 1], to: [1, 0, 1], mass: 0.1, stiffness: 50}
+  - {<<: *rope, name: b}
+)",
+    "bad.yaml:3: bodies[1].<<", { "merge keys are not supported" } },
+
   { "MalformedYaml", R"(bodies:
   - name: b
     nodes: [{position: [0, 0, 0], mass: 1}

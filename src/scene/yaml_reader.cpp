@@ -159,6 +159,12 @@ void requireMapping(const Context& ctx, const Field& field)
 {
   if (!field.node.IsMap())
     ctx.fail(field, "expected a mapping, got " + describe(field.node));
+  // yaml-cpp reads a merge key as a key named "<<": without this, `{<<: *rope, name: b}` would fail on
+  // a missing `type` or an unknown key '<<', neither of which says what is wrong.
+  for (const auto& entry : field.node)
+    if (entry.first.IsScalar() && !isQuoted(entry.first) && entry.first.Scalar() == "<<")
+      ctx.fail(entry.first.Mark(), childPath(field.path, "<<"),
+               "YAML merge keys are not supported; write the keys out (an alias *name may stand for a whole value)");
 }
 
 /// A mapping whose keys are unique strings from `allowed`. Duplicates are rejected because yaml-cpp
