@@ -179,9 +179,10 @@ TEST(SceneLoader, EveryIntegratorNameIsAccepted)
 {
   for (const std::string& name : integratorNames())
   {
-    const SceneDef scene = parseScene("physics: {integrator: " + name +
-                                          "}\nbodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]\n",
-                                      "integrator.yaml");
+    const SceneDef scene =
+        parseScene("physics: {integrator: " + name +
+                       "}\nbodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]\n",
+                   "integrator.yaml");
     EXPECT_EQ(integratorName(scene.physics.integrator), name);
   }
 }
@@ -604,6 +605,26 @@ bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
     "bad.yaml:8: bodies[0].constraints[0].rest_length", { "must be >= 0", "-0.2" } },
 
+  // --- work per step of the procedurally animated bodies (kMaxUpdatesPerStep, kMaxRelaxationPasses)
+  { "CreatureIterationsOverTheLimit", R"(bodies: [{name: c, type: creature, iterations: 101}]
+)",
+    "bad.yaml:1: bodies[0].iterations", { "[1, 100]", "101" } },
+  { "LimbIterationsOverTheLimit", R"(bodies: [{name: l, type: limb, iterations: 1000000}]
+)",
+    "bad.yaml:1: bodies[0].iterations", { "[1, 100]", "1000000" } },
+  { "HumanoidMaxFramesPerStepOverTheLimit", R"(bodies: [{name: h, type: humanoid, max_frames_per_step: 1e9}]
+)",
+    "bad.yaml:1: bodies[0].max_frames_per_step", { "(0, 100]", "1e9" } },
+  { "CreatureUpdatePeriodFarBelowDt", R"(physics: {dt: 0.01}
+bodies: [{name: c, type: creature, update_period: 1e-9}]
+)",
+    "bad.yaml:2: bodies[0].update_period",
+    { "physics.dt / update_period = 1e+07 updates per physics step", "more than 100" } },
+  { "CreatureDtFarAboveTheDefaultPeriod", R"(physics: {dt: 10}
+bodies: [{name: c, type: creature}]
+)",
+    "bad.yaml:2: bodies[0]", { "physics.dt / update_period = 300 updates per physics step" } },
+
   // --- non-finite numbers
   { "NanMass", R"(bodies:
   - name: b
@@ -744,12 +765,29 @@ bodies: []
     "bad.yaml:4: bodies[0].nodes", { "must not be empty" } },
 
   // --- the document itself
+  { "MergeKey", R"(bodies:
+  - &rope {name: a, type: rope, nodes: 8, from: [0, 0, 1], to: [1, 0, 1], mass: 0.1, stiffness: 50}
+  - {<<: *rope, name: b}
+)",
+    "bad.yaml:3: bodies[1].<<", { "merge keys are not supported" } },
+
   { "MalformedYaml", R"(bodies:
   - name: b
     nodes: [{position: [0, 0, 0], mass: 1}
   - name: c
 )",
     "bad.yaml:4:3", { "invalid YAML", "illegal block entry" } },
+  { "ControlCharacterInYamlErrorIsEscaped", "bodies: \"\\\x01\"\n", "bad.yaml:1:12",
+    { "invalid YAML", "unknown escape character: ?" } },
+  // yaml-cpp 0.7's LoadAll loops on these, collecting empty documents until memory runs out.
+  { "StrayCommaAtTopLevel", R"(,
+)",
+    "bad.yaml:1:1", { "invalid YAML", "unexpected ','" } },
+  { "StrayCommaAfterTheScene", R"(bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
+---
+,
+)",
+    "bad.yaml:3:1", { "invalid YAML", "unexpected ','" } },
   { "TopLevelIsAList", R"(- name: b
   type: custom
 )",
@@ -863,7 +901,8 @@ TEST(SceneLoader, HugeBodiesAreRefusedBeforeTheyExhaustMemory)
   const std::string rope = "{type: rope, nodes: 600000, from: [0, 0, 0], to: [1, 0, 0], mass: 1, stiffness: 1}";
   expectSceneError("bodies:\n  - " + rope.substr(0, rope.size() - 1) + ", name: a}\n  - " +
                        rope.substr(0, rope.size() - 1) + ", name: b}\n",
-                   "bad.yaml:3: bodies[1]", { "1200000 nodes", "more than 1000000" });
+                   "bad.yaml:3: bodies[1].nodes",
+                   { "1200000 nodes", "more than 1000000", "600000 in the bodies before this one" });
   expectSceneError(R"(bodies:
   - {name: c, type: creature, tendrils: {segments: 2000000000}}
 )",
@@ -873,6 +912,54 @@ TEST(SceneLoader, HugeBodiesAreRefusedBeforeTheyExhaustMemory)
 )",
                    "bad.yaml:2: bodies[0].curve_samples", { "[2, 10000]" });
 }
+
+/// A body that would take the scene over its limit of 10^6 nodes after a rope of 999,998 nodes: each type
+/// counts its nodes before building them.
+struct OverBudget
+{
+  const char* name;
+  const char* body;      ///< the second body, a flow mapping on line 3
+  const char* location;  ///< "bad.yaml:3: bodies[1]..."
+};
+
+void PrintTo(const OverBudget& over, std::ostream* out) { *out << over.name; }
+
+const OverBudget kOverBudget[] = {
+  { "Custom", "{name: b, type: custom, nodes: [&n {position: [0, 0, 0], mass: 1}, *n, *n]}",
+    "bad.yaml:3: bodies[1].nodes" },
+  { "Rope", "{name: b, type: rope, nodes: 3, from: [0, 0, 0], to: [1, 0, 0], mass: 1, stiffness: 1}",
+    "bad.yaml:3: bodies[1].nodes" },
+  { "Cloth",
+    "{name: b, type: cloth, nx: 3, ny: 2, top_left: [0, 0, 1], top_right: [1, 0, 1], bottom_left: [0, 0, 0], "
+    "mass: 1, structural: {stiffness: 1}, shear: {stiffness: 1}}",
+    "bad.yaml:3: bodies[1].ny" },
+  { "Jelly",
+    "{name: b, type: jelly, nx: 1, ny: 1, top_left: [0, 0, 1], top_right: [1, 0, 1], bottom_left: [0, 0, 0], "
+    "mass: 1, edges: {stiffness: 1}, diagonals: {stiffness: 1}, pressure: 1}",
+    "bad.yaml:3: bodies[1].ny" },
+  { "Creature", "{name: b, type: creature}", "bad.yaml:3: bodies[1]" },
+  { "CreatureTendrils", "{name: b, type: creature, tendrils: {segments: 1}}",
+    "bad.yaml:3: bodies[1].tendrils.segments" },
+  { "Limb", "{name: b, type: limb}", "bad.yaml:3: bodies[1]" },
+  { "Humanoid", "{name: b, type: humanoid}", "bad.yaml:3: bodies[1]" },
+};
+
+class OverBudgetTest : public ::testing::TestWithParam<OverBudget>
+{
+};
+
+TEST_P(OverBudgetTest, IsRefusedAtItsNodeCount)
+{
+  const OverBudget& over = GetParam();
+  const std::string yaml = std::string("bodies:\n"
+                                       "  - {name: a, type: rope, nodes: 999998, from: [0, 0, 0], to: [1, 0, 0], "
+                                       "mass: 1, stiffness: 1}\n  - ") +
+                           over.body + "\n";
+  expectSceneError(yaml, over.location, { "more than 1000000", "999998 in the bodies before this one" });
+}
+
+INSTANTIATE_TEST_SUITE_P(SceneLoader, OverBudgetTest, ::testing::ValuesIn(kOverBudget),
+                         [](const ::testing::TestParamInfo<OverBudget>& info) { return std::string(info.param.name); });
 
 TEST(SceneLoader, RateIsReadWithADefaultOfSixtyHertz)
 {

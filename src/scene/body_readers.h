@@ -4,6 +4,7 @@
 // name and type and reads the anchors, whose node indices refer to the expanded body.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "yaml_reader.h"
@@ -15,11 +16,47 @@ struct LimbMotion;
 
 namespace soft_body_sim::scene_yaml
 {
-using BodyReader = BodyDef (*)(const Context& ctx, const Field& body);
-
 /// The most nodes a scene may have, in all its bodies: a typo such as `nx: 100000` or
 /// `segments: 1e9` fails with a message rather than exhausting memory.
 constexpr long long kMaxSceneNodes = 1000000;
+
+/// The most updates a procedurally animated body may make per physics step, and the most relaxation
+/// passes per update. Both multiply the work of every step (the seeds make 1 to 4 updates of 1 to 8
+/// passes), so that a typo such as `update_period: 1e-9` or `iterations: 1000000` fails with a message
+/// rather than stalling the simulation.
+constexpr long long kMaxUpdatesPerStep = 100;
+constexpr long long kMaxRelaxationPasses = 100;
+
+/// `iterations` of a procedurally animated body: an integer in [1, kMaxRelaxationPasses].
+inline int readRelaxationPasses(const Context& ctx, const Field& field)
+{
+  const long long passes = readInteger(ctx, field);
+  if (passes < 1 || passes > kMaxRelaxationPasses)
+    ctx.fail(field, "must be an integer in [1, " + std::to_string(kMaxRelaxationPasses) + "], got " +
+                        field.node.Scalar());
+  return static_cast<int>(passes);
+}
+
+/// What a body's reader needs of the scene read before the body: the physics (read first) and the
+/// nodes of the bodies before it.
+struct SceneSoFar
+{
+  const PhysicsDef& physics;
+  long long nodes = 0;  ///< nodes of the bodies before this one
+
+  /// Fails at `field` if a body of `body_nodes` nodes would take the scene over kMaxSceneNodes. Each reader
+  /// calls it before building its body, so that a scene over the limit fails without first taking the
+  /// memory of the body that crosses it (a cloth of 10^6 nodes holds 6 10^6 springs).
+  void requireNodes(const Context& ctx, const Field& field, long long body_nodes) const
+  {
+    if (nodes + body_nodes > kMaxSceneNodes)
+      ctx.fail(field, "the scene would have " + std::to_string(nodes + body_nodes) + " nodes, more than " +
+                          std::to_string(kMaxSceneNodes) +
+                          (nodes > 0 ? " (" + std::to_string(nodes) + " in the bodies before this one)" : ""));
+  }
+};
+
+using BodyReader = BodyDef (*)(const Context& ctx, const Field& body, const SceneSoFar& scene);
 
 struct BodyType
 {
@@ -33,15 +70,15 @@ const std::vector<BodyType>& bodyTypes();
 /// The keys every body type allows around its own: name, type, <own...>, anchors.
 Keys withCommonBodyKeys(const Keys& own);
 
-BodyDef readCustomBody(const Context& ctx, const Field& body);
-BodyDef readRopeBody(const Context& ctx, const Field& body);
-BodyDef readClothBody(const Context& ctx, const Field& body);
-BodyDef readJellyBody(const Context& ctx, const Field& body);
+BodyDef readCustomBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
+BodyDef readRopeBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
+BodyDef readClothBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
+BodyDef readJellyBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 
 // Procedurally animated body types (creature, limb, humanoid).
-BodyDef readCreatureBody(const Context& ctx, const Field& body);
-BodyDef readLimbBody(const Context& ctx, const Field& body);
-BodyDef readHumanoidBody(const Context& ctx, const Field& body);
+BodyDef readCreatureBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
+BodyDef readLimbBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
+BodyDef readHumanoidBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 /// The limb-motion keys that `limb` and `humanoid` share (limb_reader.cpp): gravity, frame_period,
 /// max_frames_per_step, iterations, tension, retention, curve_samples.
 const Keys& limbMotionKeys();

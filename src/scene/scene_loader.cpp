@@ -128,7 +128,7 @@ void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
   }
 }
 
-BodyDef readBody(const Context& ctx, const Field& field)
+BodyDef readBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMapping(ctx, field);
   // The type decides which other keys are allowed, so it is checked before them.
@@ -139,7 +139,7 @@ BodyDef readBody(const Context& ctx, const Field& field)
   {
     if (name == body_type.name)
     {
-      BodyDef body = body_type.read(ctx, field);
+      BodyDef body = body_type.read(ctx, field, scene);
       body.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
       body.type = name;
       if (const std::optional<Field> anchors = optionalKey(field, "anchors"))
@@ -170,14 +170,11 @@ SceneDef readScene(const Context& ctx, const Field& root)
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error
-  long long nodes = 0;
+  SceneSoFar so_far{ scene.physics };
   for (const Field& item : requireList(ctx, bodies))
   {
-    scene.bodies.push_back(readBody(ctx, item));
-    nodes += static_cast<long long>(scene.bodies.back().nodes.size());
-    if (nodes > kMaxSceneNodes)
-      ctx.fail(item, "the scene would have " + std::to_string(nodes) + " nodes, more than " +
-                         std::to_string(kMaxSceneNodes));
+    scene.bodies.push_back(readBody(ctx, item, so_far));
+    so_far.nodes += static_cast<long long>(scene.bodies.back().nodes.size());
     const std::string& name = scene.bodies.back().name;
     const auto [first, inserted] = path_by_name.emplace(name, item.path);
     if (!inserted)
@@ -212,22 +209,7 @@ SceneDef loadSceneFile(const std::string& path)
 SceneDef parseScene(const std::string& yaml_text, const std::string& source)
 {
   const Context ctx(source);
-  std::vector<YAML::Node> documents;
-  try
-  {
-    // All documents, not just the first: a second one would otherwise be silently ignored.
-    documents = YAML::LoadAll(yaml_text);
-  }
-  catch (const YAML::ParserException& e)
-  {
-    throw SceneError(source + ":" + std::to_string(e.mark.line + 1) + ":" + std::to_string(e.mark.column + 1) +
-                     ": invalid YAML: " + e.msg);
-  }
-  // A trailing "---" (an empty document) holds nothing that could be ignored; any other one would be.
-  for (std::size_t i = 1; i < documents.size(); ++i)
-    if (!documents[i].IsNull())
-      ctx.fail(documents[i].Mark(), "", "found a second YAML document; a scene file holds exactly one");
-  const YAML::Node root = documents.empty() ? YAML::Node() : documents.front();
+  const YAML::Node root = loadSingleDocument(ctx, yaml_text);
   return readScene(ctx, Field{ root, "", root.Mark() });
 }
 

@@ -4,7 +4,11 @@
 #include <charconv>
 #include <climits>
 #include <cmath>
+#include <optional>
 #include <set>
+#include <sstream>
+
+#include <yaml-cpp/eventhandler.h>
 
 namespace soft_body_sim::scene_yaml
 {
@@ -12,7 +16,91 @@ namespace
 {
 /// yaml-cpp gives quoted scalars the tag "!" and plain ones "?"; a quoted "1.5" is a string in YAML.
 bool isQuoted(const YAML::Node& node) { return node.Tag() == "!"; }
+
+/// Where the last document of a stream started and the mark of its root node unless that is null,
+/// from the parser's events, without building the document.
+class DocumentOutline : public YAML::EventHandler
+{
+public:
+  YAML::Mark start;
+  std::optional<YAML::Mark> root;
+
+  void OnDocumentStart(const YAML::Mark& mark) override
+  {
+    start = mark;
+    root.reset();
+  }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { node(mark); }
+  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string&) override
+  {
+    node(mark);
+  }
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override
+  {
+    node(mark);
+  }
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override
+  {
+    node(mark);
+  }
+  void OnMapEnd() override {}
+
+private:
+  /// The first node of a document is its root; the others are inside it.
+  void node(const YAML::Mark& mark)
+  {
+    if (!root)
+      root = mark;
+  }
+};
+
+/// `reason` may quote the input (yaml-cpp's "unknown escape character: <the character>"): it is made printable.
+[[noreturn]] void failInvalid(const Context& ctx, const YAML::Mark& mark, const std::string& reason)
+{
+  throw SceneError(ctx.source() + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1) +
+                   ": invalid YAML: " + printable(reason));
+}
 }  // namespace
+
+// --- the document ------------------------------------------------------------------------------
+
+/// YAML::LoadAll is not used: yaml-cpp 0.7 never returns from it on a token that cannot start a node,
+/// such as a stray ',' at the top level (jbeder/yaml-cpp#1040, fixed after 0.8 by #1319). Its parser
+/// then reports an empty document without consuming the token, again and again, and LoadAll collects
+/// them until memory runs out. So the stream is first walked document by document, stopping at the
+/// first document that starts where the one before started; the first document is then built alone.
+YAML::Node loadSingleDocument(const Context& ctx, const std::string& text)
+{
+  try
+  {
+    std::istringstream stream(text);
+    YAML::Parser parser(stream);
+    DocumentOutline outline;
+    std::optional<YAML::Mark> previous_start;
+    for (; parser.HandleNextDocument(outline); previous_start = outline.start)
+    {
+      if (previous_start && outline.start.pos == previous_start->pos)
+      {
+        const std::size_t at = static_cast<std::size_t>(std::max(outline.start.pos, 0));
+        const bool printable_ascii = at < text.size() && text[at] > ' ' && text[at] < 0x7f;
+        failInvalid(ctx, outline.start,
+                    printable_ascii ? "unexpected " + quoted(text.substr(at, 1)) : "unexpected token");
+      }
+      // A trailing "---" (an empty document) holds nothing that could be ignored; any other one would be.
+      if (previous_start && outline.root)
+        ctx.fail(*outline.root, "", "found a second YAML document; a scene file holds exactly one");
+    }
+    return YAML::Load(text);
+  }
+  catch (const YAML::ParserException& e)
+  {
+    failInvalid(ctx, e.mark, e.msg);
+  }
+}
+
 
 std::string join(const Keys& words)
 {
@@ -65,12 +153,18 @@ std::string childPath(const std::string& parent, const std::string& key)
   return parent.empty() ? key : parent + "." + key;
 }
 
-// --- structure// --- structure ---------------------------------------------------------------------------------
+// --- structure ---------------------------------------------------------------------------------
 
 void requireMapping(const Context& ctx, const Field& field)
 {
   if (!field.node.IsMap())
     ctx.fail(field, "expected a mapping, got " + describe(field.node));
+  // yaml-cpp reads a merge key as a key named "<<": without this, `{<<: *rope, name: b}` would fail on
+  // a missing `type` or an unknown key '<<', neither of which says what is wrong.
+  for (const auto& entry : field.node)
+    if (entry.first.IsScalar() && !isQuoted(entry.first) && entry.first.Scalar() == "<<")
+      ctx.fail(entry.first.Mark(), childPath(field.path, "<<"),
+               "YAML merge keys are not supported; write the keys out (an alias *name may stand for a whole value)");
 }
 
 /// A mapping whose keys are unique strings from `allowed`. Duplicates are rejected because yaml-cpp

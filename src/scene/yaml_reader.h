@@ -40,6 +40,8 @@ class Context
 public:
   explicit Context(std::string source) : source_(std::move(source)) {}
 
+  const std::string& source() const { return source_; }
+
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path, const std::string& reason) const
   {
     // An empty document has no mark (line -1); it is still "line 1" to the reader.
@@ -56,6 +58,10 @@ public:
 private:
   std::string source_;
 };
+
+/// The first document of `text`, its one document that may hold anything (a trailing empty one may
+/// follow). Invalid YAML fails as "<source>:<line>:<column>: invalid YAML: <reason>".
+YAML::Node loadSingleDocument(const Context& ctx, const std::string& text);
 
 /// A mapping (any keys).
 void requireMapping(const Context& ctx, const Field& field);

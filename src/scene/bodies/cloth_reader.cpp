@@ -3,7 +3,7 @@
 
 namespace soft_body_sim::scene_yaml
 {
-BodyDef readClothBody(const Context& ctx, const Field& field)
+BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass",
                                               "structural", "shear", "bending", "pinned" }));
@@ -12,6 +12,7 @@ BodyDef readClothBody(const Context& ctx, const Field& field)
   const Field ny = requiredKey(ctx, field, "ny");
   cloth.ny = readCount(ctx, ny, 2);
   checkGridSize(ctx, ny, cloth.nx, cloth.ny);
+  scene.requireNodes(ctx, ny, static_cast<long long>(cloth.nx) * cloth.ny);
   cloth.corners = readGridCorners(ctx, field);
   cloth.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
   cloth.structural = readSpringParameters(ctx, requiredKey(ctx, field, "structural"));

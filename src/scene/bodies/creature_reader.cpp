@@ -1,4 +1,5 @@
 // `type: creature`: the codeling of fuzzy-physics-constraints.txt (see core/bodies/creature.h).
+#include <sstream>
 #include <stdexcept>
 
 #include "../body_readers.h"
@@ -77,7 +78,7 @@ Field firstPresent(const Field& body, const Keys& keys)
 
 }  // namespace
 
-BodyDef readCreatureBody(const Context& ctx, const Field& field)
+BodyDef readCreatureBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys(kCreatureKeys));
   CreatureDef def;
@@ -120,9 +121,16 @@ BodyDef readCreatureBody(const Context& ctx, const Field& field)
   if (const std::optional<Field> value = optionalKey(field, "hard_strength"))
     def.hard_strength = readStrength(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "iterations"))
-    def.iterations = readAtLeastOne(ctx, *value);
+    def.iterations = readRelaxationPasses(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "tendrils"))
+  {
     def.tendrils = readTendrils(ctx, *value);
+    scene.requireNodes(ctx, firstPresent(*value, { "segments" }), kCreatureBodyPoints + 2LL * def.tendrils->segments);
+  }
+  else
+  {
+    scene.requireNodes(ctx, field, kCreatureBodyPoints);
+  }
 
   // Checks across keys, pointed at the first of the keys involved that the file sets.
   const double k_t2 = def.stiffness * def.update_period * def.update_period;
@@ -130,6 +138,17 @@ BodyDef readCreatureBody(const Context& ctx, const Field& field)
     ctx.fail(firstPresent(field, { "stiffness", "update_period", "lead_retention" }),
              "stiffness * update_period^2 = " + std::to_string(k_t2) + " must be < 2 (1 + lead_retention) = " +
                  std::to_string(2.0 * (1.0 + def.lead_retention)) + " for the lead's recurrence to be stable");
+  // The creature makes every update due in a step, however many (a `dt: auto` step is only known when the
+  // world is built, so only a given dt is checked).
+  const double updates_per_step = scene.physics.step.dt / def.update_period;
+  if (!scene.physics.auto_dt && updates_per_step > kMaxUpdatesPerStep)
+  {
+    std::ostringstream updates;  // 6 significant digits, an exponent for large values
+    updates << updates_per_step;
+    ctx.fail(firstPresent(field, { "update_period" }), "physics.dt / update_period = " + updates.str() +
+                                                           " updates per physics step, more than " +
+                                                           std::to_string(kMaxUpdatesPerStep));
+  }
   const Vec3 normal = def.plane_normal.normalized();
   if (!((def.heading - normal * normal.dot(def.heading)).norm() > 1e-9 * def.heading.norm()))
     ctx.fail(firstPresent(field, { "heading", "plane_normal" }),

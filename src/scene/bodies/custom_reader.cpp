@@ -59,12 +59,14 @@ ConstraintDef readConstraint(const Context& ctx, const Field& field, std::size_t
 
 }  // namespace
 
-BodyDef readCustomBody(const Context& ctx, const Field& field)
+BodyDef readCustomBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nodes", "springs", "constraints" }));
   BodyDef body;
   const Field nodes = requiredKey(ctx, field, "nodes");
-  for (const Field& item : requireList(ctx, nodes))
+  const std::vector<Field> items = requireList(ctx, nodes);
+  scene.requireNodes(ctx, nodes, static_cast<long long>(items.size()));
+  for (const Field& item : items)
     body.nodes.push_back(readNode(ctx, item));
   if (body.nodes.empty())
     ctx.fail(nodes, "must not be empty; a body needs at least one node");

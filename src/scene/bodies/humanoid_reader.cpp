@@ -31,9 +31,10 @@ Vec3 readNonZeroVec3(const Context& ctx, const Field& field)
 }
 }  // namespace
 
-BodyDef readHumanoidBody(const Context& ctx, const Field& field)
+BodyDef readHumanoidBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys(humanoidKeys()));
+  scene.requireNodes(ctx, field, kHumanoidNodes);
   HumanoidDef def;
   if (const std::optional<Field> value = optionalKey(field, "position"))
     def.position = readVec3(ctx, *value);

@@ -4,7 +4,7 @@
 
 namespace soft_body_sim::scene_yaml
 {
-BodyDef readJellyBody(const Context& ctx, const Field& field)
+BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass", "edges",
                                               "diagonals", "pressure" }));
@@ -13,6 +13,7 @@ BodyDef readJellyBody(const Context& ctx, const Field& field)
   const Field ny = requiredKey(ctx, field, "ny");
   jelly.ny = readCount(ctx, ny, 1);
   checkGridSize(ctx, ny, jelly.nx + 1LL, jelly.ny + 1LL);
+  scene.requireNodes(ctx, ny, (jelly.nx + 1LL) * (jelly.ny + 1LL));
   jelly.corners = readGridCorners(ctx, field);
   jelly.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
   jelly.edges = readSpringParameters(ctx, requiredKey(ctx, field, "edges"));

@@ -33,9 +33,13 @@ void readLimbMotion(const Context& ctx, const Field& body, LimbMotion& motion)
   if (const std::optional<Field> value = optionalKey(body, "frame_period"))
     motion.frame_period = readPositive(ctx, *value);
   if (const std::optional<Field> value = optionalKey(body, "max_frames_per_step"))
+  {
     motion.max_frames_per_step = readPositive(ctx, *value);
+    if (motion.max_frames_per_step > kMaxUpdatesPerStep)
+      ctx.fail(*value, "must be in (0, " + std::to_string(kMaxUpdatesPerStep) + "], got " + value->node.Scalar());
+  }
   if (const std::optional<Field> value = optionalKey(body, "iterations"))
-    motion.iterations = readAtLeastOne(ctx, *value);
+    motion.iterations = readRelaxationPasses(ctx, *value);
   if (const std::optional<Field> value = optionalKey(body, "tension"))
   {
     motion.tension = readPositive(ctx, *value);
@@ -55,14 +59,16 @@ void readLimbMotion(const Context& ctx, const Field& body, LimbMotion& motion)
     // Every published marker carries the curve: a few dozen points draw it smoothly.
     constexpr long long kMaxCurveSamples = 10000;
     if (samples < 2 || samples > kMaxCurveSamples)
-      ctx.fail(*value, "must be an integer in [2, " + std::to_string(kMaxCurveSamples) + "], got " + value->node.Scalar());
+      ctx.fail(*value,
+               "must be an integer in [2, " + std::to_string(kMaxCurveSamples) + "], got " + value->node.Scalar());
     motion.curve_samples = static_cast<int>(samples);
   }
 }
 
-BodyDef readLimbBody(const Context& ctx, const Field& field)
+BodyDef readLimbBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys(limbKeys()));
+  scene.requireNodes(ctx, field, kLimbLeaf + 1);
   LimbDef def;
   if (const std::optional<Field> value = optionalKey(field, "root"))
     def.root = readVec3(ctx, *value);

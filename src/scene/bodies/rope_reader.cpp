@@ -4,12 +4,14 @@
 
 namespace soft_body_sim::scene_yaml
 {
-BodyDef readRopeBody(const Context& ctx, const Field& field)
+BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nodes", "from", "to", "mass", "stiffness", "damping", "bending",
                                               "bending_damping", "pinned" }));
   RopeDef rope;
-  rope.nodes = readCount(ctx, requiredKey(ctx, field, "nodes"), 2);
+  const Field nodes = requiredKey(ctx, field, "nodes");
+  rope.nodes = readCount(ctx, nodes, 2);
+  scene.requireNodes(ctx, nodes, rope.nodes);
   rope.from = readVec3(ctx, requiredKey(ctx, field, "from"));
   const Field to = requiredKey(ctx, field, "to");
   rope.to = readVec3(ctx, to);
