@@ -125,7 +125,8 @@ void World::rebuildGroups()
     for (int i = 0; i < m.nodeCount(); ++i)
       if (!mine(i))
         m.inverse_mass[i] = 0.0;
-    // Elements between two other nodes only; collisions are the world's stage, not the group's.
+    // The elements that touch a node of the group (the others belong to other groups); no planes:
+    // collisions are the world's stage, not the group's.
     m.springs.clear();
     std::copy_if(model_.springs.begin(), model_.springs.end(), std::back_inserter(m.springs),
                  [&](const Spring& s) { return mine(s.a) || mine(s.b); });
