@@ -875,6 +875,9 @@ bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]
     anchors: [{name: end, node: 0, frame: ""}]
 )",
     "bad.yaml:5: bodies[0].anchors[0].frame", { "empty" } },
+  { "CarriageReturnInAValueStaysOneLine",
+    "physics: {dt: 0.0\r}\nbodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]\n",
+    "bad.yaml:1: physics.dt", { "must be > 0, got 0.0?" } },
   { "MultiLineValueStaysOneLine", R"(physics:
   integrator: "semi\nimplicit"
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]

@@ -202,7 +202,7 @@ SceneDef loadSceneFile(const std::string& path)
     file.setstate(std::ios_base::badbit);
   }
   if (!file || file.bad())
-    throw SceneError(path + ": cannot open scene file");
+    throw SceneError(escapeControlCharacters(path) + ": cannot open scene file");
   return parseScene(text, path);
 }
 

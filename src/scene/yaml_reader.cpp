@@ -57,21 +57,21 @@ private:
   }
 };
 
-/// `reason` may quote the input (yaml-cpp's "unknown escape character: <the character>"): it is made printable.
+/// `reason` may quote the input (yaml-cpp's "unknown escape character: <the character>").
 [[noreturn]] void failInvalid(const Context& ctx, const YAML::Mark& mark, const std::string& reason)
 {
-  throw SceneError(ctx.source() + ":" + std::to_string(mark.line + 1) + ":" + std::to_string(mark.column + 1) +
-                   ": invalid YAML: " + printable(reason));
+  throw SceneError(escapeControlCharacters(ctx.source() + ":" + std::to_string(mark.line + 1) + ":" +
+                                           std::to_string(mark.column + 1) + ": invalid YAML: " + reason));
 }
 }  // namespace
 
 // --- the document ------------------------------------------------------------------------------
 
 /// YAML::LoadAll is not used: yaml-cpp 0.7 never returns from it on a token that cannot start a node,
-/// such as a stray ',' at the top level (jbeder/yaml-cpp#1040, fixed after 0.8 by #1319). Its parser
-/// then reports an empty document without consuming the token, again and again, and LoadAll collects
-/// them until memory runs out. So the stream is first walked document by document, stopping at the
-/// first document that starts where the one before started; the first document is then built alone.
+/// such as a stray ',' at the top level (jbeder/yaml-cpp#1040; fixed by #1319 in 2024, after 0.8.0). Its
+/// parser then reports an empty document without consuming the token, again and again, and LoadAll
+/// collects them until memory runs out. So the stream is first walked document by document, stopping at
+/// the first document that starts where the one before started; the first document is then built alone.
 YAML::Node loadSingleDocument(const Context& ctx, const std::string& text)
 {
   try
@@ -110,12 +110,10 @@ std::string join(const Keys& words)
   return out;
 }
 
-/// User text made safe for a one-line message: control characters escaped, long text shortened.
-std::string printable(const std::string& text)
+std::string escapeControlCharacters(const std::string& text)
 {
-  constexpr std::size_t kMaxLength = 60;
   std::string out;
-  for (const char c : text.substr(0, kMaxLength))
+  for (const char c : text)
   {
     if (c == '\n')
       out += "\\n";
@@ -124,6 +122,14 @@ std::string printable(const std::string& text)
     else
       out += c;
   }
+  return out;
+}
+
+/// User text made safe for a one-line message: control characters escaped, long text shortened.
+std::string printable(const std::string& text)
+{
+  constexpr std::size_t kMaxLength = 60;
+  const std::string out = escapeControlCharacters(text.substr(0, kMaxLength));
   return text.size() > kMaxLength ? out + "..." : out;
 }
 

@@ -17,6 +17,8 @@ namespace soft_body_sim::scene_yaml
 using Keys = std::vector<std::string>;
 
 std::string join(const Keys& words);
+/// `text` on one printable line: a newline becomes "\n", any other control character '?'.
+std::string escapeControlCharacters(const std::string& text);
 /// User text made safe for a one-line message: control characters escaped, long text shortened.
 std::string printable(const std::string& text);
 std::string quoted(const std::string& text);
@@ -42,12 +44,13 @@ public:
 
   const std::string& source() const { return source_; }
 
+  /// The message is escaped as a whole: a reason may quote a value as the file wrote it ("got 0.0\r").
   [[noreturn]] void fail(const YAML::Mark& mark, const std::string& path, const std::string& reason) const
   {
     // An empty document has no mark (line -1); it is still "line 1" to the reader.
     const int line = std::max(mark.line, 0) + 1;
-    throw SceneError(source_ + ":" + std::to_string(line) + ": " + (path.empty() ? "(top level)" : path) +
-                     ": " + reason);
+    throw SceneError(escapeControlCharacters(source_ + ":" + std::to_string(line) + ": " +
+                                             (path.empty() ? "(top level)" : path) + ": " + reason));
   }
 
   [[noreturn]] void fail(const Field& field, const std::string& reason) const
