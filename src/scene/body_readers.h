@@ -4,6 +4,7 @@
 // name and type and reads the anchors, whose node indices refer to the expanded body.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -55,6 +56,23 @@ struct SceneSoFar
                           (nodes > 0 ? " (" + std::to_string(nodes) + " in the bodies before this one)" : ""));
   }
 };
+
+/// The last stage of a procedural body's reader: `build(name, def)` (buildCreature, buildLimb, ...) with
+/// the body's name, which its own checks quote. A std::invalid_argument from a check the reader did not
+/// make is still one line at the body.
+template <typename Def, typename Build>
+BodyDef buildProceduralBody(const Context& ctx, const Field& field, const Def& def, Build build)
+{
+  const std::string name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
+  try
+  {
+    return build(name, def);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    ctx.fail(field, e.what());
+  }
+}
 
 using BodyReader = BodyDef (*)(const Context& ctx, const Field& body, const SceneSoFar& scene);
 

@@ -1,6 +1,5 @@
 // `type: creature`: the codeling of fuzzy-physics-constraints.txt (see core/bodies/creature.h).
 #include <sstream>
-#include <stdexcept>
 
 #include "../body_readers.h"
 #include "soft_body_sim/core/bodies/creature.h"
@@ -154,15 +153,7 @@ BodyDef readCreatureBody(const Context& ctx, const Field& field, const SceneSoFa
     ctx.fail(firstPresent(field, { "heading", "plane_normal" }),
              "heading must not be parallel to plane_normal (the spine lies in the swimming plane)");
 
-  const std::string name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
-  try
-  {
-    return buildCreature(name, def);
-  }
-  catch (const std::invalid_argument& e)  // any check not made above: still one line at the body
-  {
-    ctx.fail(field, e.what());
-  }
+  return buildProceduralBody(ctx, field, def, buildCreature);
 }
 
 }  // namespace soft_body_sim::scene_yaml

@@ -1,6 +1,5 @@
 // `type: humanoid`: a torso following a target with four Bezier limbs (see core/bodies/humanoid.h).
 #include <iterator>
-#include <stdexcept>
 
 #include <Eigen/Geometry>  // cross products
 
@@ -79,15 +78,7 @@ BodyDef readHumanoidBody(const Context& ctx, const Field& field, const SceneSoFa
                      " must be < 2 (1 + torso_retention) for the torso's recurrence to be stable");
   }
 
-  const std::string name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
-  try
-  {
-    return buildHumanoid(name, def);
-  }
-  catch (const std::invalid_argument& e)  // any check not made above: still one line at the body
-  {
-    ctx.fail(field, e.what());
-  }
+  return buildProceduralBody(ctx, field, def, buildHumanoid);
 }
 
 }  // namespace soft_body_sim::scene_yaml

@@ -1,6 +1,5 @@
 // `type: limb`: one 3-particle Verlet limb of verlet-bezier-limbs.txt (see core/bodies/limb.h), and the
 // limb-motion keys it shares with `humanoid`.
-#include <stdexcept>
 
 #include "../body_readers.h"
 #include "soft_body_sim/core/bodies/limb.h"
@@ -84,15 +83,7 @@ BodyDef readLimbBody(const Context& ctx, const Field& field, const SceneSoFar& s
     def.lower_length = readPositive(ctx, *value);
   readLimbMotion(ctx, field, def.motion);
 
-  const std::string name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
-  try
-  {
-    return buildLimb(name, def);
-  }
-  catch (const std::invalid_argument& e)  // any check not made above: still one line at the body
-  {
-    ctx.fail(field, e.what());
-  }
+  return buildProceduralBody(ctx, field, def, buildLimb);
 }
 
 }  // namespace soft_body_sim::scene_yaml
