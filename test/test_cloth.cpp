@@ -270,8 +270,6 @@ TEST(ClothKeys, NoBendingKeyNoBendingSprings)
     EXPECT_FALSE(node.pinned);
 }
 
-
-
 class ClothKeysReject : public ::testing::TestWithParam<BadKeys>
 {
 };

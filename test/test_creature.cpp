@@ -494,7 +494,6 @@ std::string creatureWith(const std::string& line)
   return "bodies:\n  - name: c\n    type: creature\n    " + line + "\n";
 }
 
-
 TEST(CreatureScene, BadValuesAreRejectedWithOneLineAtTheKey)
 {
   const std::string at = "bad.yaml:4: bodies[0].";

@@ -778,8 +778,6 @@ TEST(JellyKeys, EveryKeyIsRead)
   EXPECT_EQ(body.cells[0].pressure, 300.0);
 }
 
-
-
 class JellyKeysReject : public ::testing::TestWithParam<BadKeys>
 {
 };

@@ -416,7 +416,6 @@ TEST(HumanoidScene, EveryKeyReachesTheBody)
                    buildHumanoid("h", HumanoidDef{}), "humanoid", true);
 }
 
-
 /// A one-body scene of `type` whose 4th line is `line`.
 std::string bodyWith(const std::string& type, const std::string& line)
 {

@@ -277,7 +277,6 @@ TEST(RopeKeys, OptionalKeysDefaultToNoDampingNoBendingNothingPinned)
     EXPECT_FALSE(node.pinned);
 }
 
-
 class RopeKeysReject : public ::testing::TestWithParam<BadKeys>
 {
 };

@@ -20,7 +20,6 @@ namespace
 
 std::string sceneDir() { return std::string(SOURCE_DIR) + "/config/scenes"; }
 
-
 void expectVec3(const Vec3& actual, double x, double y, double z)
 {
   EXPECT_EQ(actual, Vec3(x, y, z)) << "actual: " << actual.transpose();

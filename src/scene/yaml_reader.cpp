@@ -101,7 +101,6 @@ YAML::Node loadSingleDocument(const Context& ctx, const std::string& text)
   }
 }
 
-
 std::string join(const Keys& words)
 {
   std::string out;
