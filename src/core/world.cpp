@@ -94,7 +94,9 @@ void World::invalidateIntegrators()
 
 void World::modelChanged()
 {
-  invalidateIntegrators();
+  integrator_->modelChanged();
+  for (IntegratorGroup& group : groups_)
+    group.integrator->modelChanged();
   if (!groups_.empty())
     groups_dirty_ = true;
 }

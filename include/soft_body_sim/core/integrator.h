@@ -38,6 +38,9 @@ public:
   /// The state was changed from outside the integrator (an anchor or controller moved its nodes, a
   /// plane contact changed a velocity, a node was set): drop anything cached from the old state.
   virtual void invalidate() {}
+  /// The model was changed (gravity, drag, stiffness, pressure, a node pinned or released): drop anything
+  /// cached from the old model as well as from the old state.
+  virtual void modelChanged() { invalidate(); }
 };
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type);

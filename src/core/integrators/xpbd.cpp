@@ -61,9 +61,9 @@ public:
     postSolve(model, state, h);
   }
 
-  /// The world calls this after changing the model (stiffness, masses, an attached node) as well as
-  /// the state: rebuild the rows at the next sweep.
-  void invalidate() override { rows_h_ = 0.0; }
+  /// The rows hold only the model's parameters and h, so a change of state (invalidate()) keeps them;
+  /// a change of the model (stiffness, masses, an attached node) orders and builds them again.
+  void modelChanged() override { reorder_ = true; }
 
 private:
   void preSolve(const Model& model, State& state, double h)
@@ -83,10 +83,11 @@ private:
   void solve(const Model& model, NodeArray& x, double h, int iterations)
   {
     const std::size_t row_count = model.springs.size() + model.constraints.size();
-    // The partition into chains depends on which nodes are pinned: checked whenever the rows are stale
-    // (invalidate() follows World::attach and detach).
-    if (order_.size() != row_count || ordered_nodes_ != model.nodeCount() || (h != rows_h_ && pinningChanged(model)))
+    // The partition into chains depends on which nodes are pinned (modelChanged() follows World::attach
+    // and detach).
+    if (reorder_ || order_.size() != row_count || ordered_nodes_ != model.nodeCount())
     {
+      reorder_ = false;
       orderRows(model);
       rows_h_ = 0.0;
     }
@@ -97,7 +98,7 @@ private:
     {
       if (iteration == 0 && h != rows_h_)
       {
-        // Rows are stale (new h, or invalidate(): the model may have been retuned): the first sweep
+        // Rows are stale (new h, or ordered again after modelChanged()): the first sweep
         // writes them as it goes, then the chains' rows are written.
         const double inverse_h2 = 1.0 / (h * h);
         for (std::size_t k = 0; k < swept_count_; ++k)
@@ -143,14 +144,6 @@ private:
     return ConstraintRow{ c.a, c.b, c.rest_length, c.compliance * inverse_h2, 0.0 };
   }
 
-  bool pinningChanged(const Model& model) const
-  {
-    for (int i = 0; i < model.nodeCount(); ++i)
-      if (free_[static_cast<std::size_t>(i)] != static_cast<std::uint8_t>(model.isFree(i)))
-        return true;
-    return false;
-  }
-
   /// The solve order: the rows swept by Gauss-Seidel (see colourRows), then the chains (see
   /// partitionRows), each in path order.
   void orderRows(const Model& model)
@@ -177,9 +170,6 @@ private:
     }
     chains_.reserve(longest);
     chain_tension_.setZero(static_cast<Eigen::Index>(order_.size()));
-    free_.resize(static_cast<std::size_t>(model.nodeCount()));
-    for (int i = 0; i < model.nodeCount(); ++i)
-      free_[static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(model.isFree(i));
     ordered_nodes_ = model.nodeCount();
   }
 
@@ -229,12 +219,12 @@ private:
   std::vector<std::uint32_t> order_;  ///< solve order of the rows (see orderRows)
   std::size_t swept_count_ = 0;       ///< order_[0, swept_count_) are swept by Gauss-Seidel
   std::vector<std::size_t> chain_starts_;  ///< chain c is order_[chain_starts_[c], chain_starts_[c + 1])
-  std::vector<std::uint8_t> free_;    ///< per node: free when the rows were ordered
   int ordered_nodes_ = -1;
   ChainSolver chains_;
   Eigen::VectorXd chain_tension_;     ///< [N] per row in solve order: the chains' tensions at the last sub-step
   std::vector<SweepRow> rows_;        ///< the rows in solve order, valid for h = rows_h_
   double rows_h_ = 0.0;               ///< [s]; 0 = rows not built
+  bool reorder_ = false;              ///< the model changed: order and build the rows again
   Eigen::VectorXd lambda_;
   Eigen::VectorXd cell_lambda_;
 };
