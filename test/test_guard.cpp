@@ -67,6 +67,7 @@ double shadowEnergy(const World& world, int node, double h)
 
 TEST(Guard, SwitchIntegratorRestoresTheBodyStepsItImplicitlyAndLeavesTheOthersAlone)
 {
+  expectGuardEvents();  // about divergence: the guard catches it
   // Symplectic Euler at w h = 50 multiplies the stiff spring's amplitude by ~2500 per step.
   const double dt = 0.05;
   World world = buildWorld(scene(IntegratorType::SemiImplicitEuler, dt, GuardPolicy::SwitchIntegrator,
@@ -113,6 +114,7 @@ TEST(Guard, SwitchIntegratorRestoresTheBodyStepsItImplicitlyAndLeavesTheOthersAl
 
 TEST(Guard, HalveStepRunsTheSpringAtHalfTheSubStepWhereSymplecticEulerIsStable)
 {
+  expectGuardEvents();  // about divergence: the guard catches it
   // w h = 2.5 is past symplectic Euler's limit 2 (amplitude x ~4 per step); w h / 2 = 1.25 is within.
   const double dt = 2.5e-3;
   SceneDef spring = scene(IntegratorType::SemiImplicitEuler, dt, GuardPolicy::HalveStep, { stiffSpring("stiff", 0.0) });
@@ -138,6 +140,7 @@ TEST(Guard, HalveStepRunsTheSpringAtHalfTheSubStepWhereSymplecticEulerIsStable)
 
 TEST(Guard, HalveStepFreezesABodyThatDivergesAtEveryStep)
 {
+  expectGuardEvents();  // about divergence: the guard catches it
   // Explicit Euler on an undamped spring gains 1 + (w h)^2 in energy per step at any h: halving cannot help.
   World world = buildWorld(scene(IntegratorType::ExplicitEuler, 1e-3, GuardPolicy::HalveStep, { stiffSpring("stiff", 0.0) }));
   for (int n = 0; n < 20000 && !world.isFrozen(0); ++n)
@@ -152,6 +155,7 @@ TEST(Guard, HalveStepFreezesABodyThatDivergesAtEveryStep)
 
 TEST(Guard, FreezeStopsTheBodyWhileAnotherFallsOnItsExactParabola)
 {
+  expectGuardEvents();  // about divergence: the guard catches it
   const double dt = 0.01;
   World world = buildWorld(scene(IntegratorType::ExplicitEuler, dt, GuardPolicy::Freeze,
                                  { stiffSpring("stiff", 0.0), ball("ball") }));
@@ -183,6 +187,7 @@ TEST(Guard, FreezeStopsTheBodyWhileAnotherFallsOnItsExactParabola)
 
 TEST(Guard, ANonFiniteOrRunawayNodeSetFromOutsideIsPutBackToTheLastSavedGoodState)
 {
+  expectGuardEvents();  // about divergence: the guard catches it
   World world = buildWorld(scene(IntegratorType::ImplicitEuler, 0.01, GuardPolicy::SwitchIntegrator,
                                  { ball("a"), ball("b") }));
   const State good = world.state();  // saved at step 0; the next save is at step kGuardCheckpointSteps
@@ -217,6 +222,7 @@ TEST(Guard, ANonFiniteOrRunawayNodeSetFromOutsideIsPutBackToTheLastSavedGoodStat
 
 TEST(Guard, AnXpbdBodyIsSwitchedToImplicitEuler)
 {
+  expectGuardEvents();  // about divergence: the guard catches it
   World world = buildWorld(scene(IntegratorType::Xpbd, 0.01, GuardPolicy::SwitchIntegrator, { ball("a") }));
   world.setNode(0, world.state().position.col(0), Vec3(std::numeric_limits<double>::infinity(), 0, 0));
   world.step();

@@ -87,6 +87,7 @@ TEST(RosConverter, StateCarriesPositionsVelocitiesAndStatistics)
 
 TEST(RosConverter, StateSaysWhatTheDivergenceGuardDidToEachBody)
 {
+  expectGuardEvents();  // about divergence: the guard catches it
   World world = twoBodies();
   // A runaway node of the pair (body 1): caught, restored; the policy switches it to implicit_euler.
   world.setNode(world.model().bodies[1].first, Vec3(1, 2, 3), Vec3(1e6, 0, 0));

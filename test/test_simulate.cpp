@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "soft_body_sim/tools/simulate.h"
+#include "test_util.h"
 
 namespace soft_body_sim
 {
@@ -66,6 +67,7 @@ std::vector<std::vector<std::string>> rows(const std::string& csv)
 
 TEST(Simulate, ReportsEachCatchOfTheDivergenceGuardOnStderr)
 {
+  test::expectGuardEvents();  // about divergence: the guard catches it
   // w h = 50 for symplectic Euler: the spring diverges within a few steps and the guard catches it.
   const std::string scene = writeScene("stiff.yaml", R"(physics:
   integrator: semi_implicit_euler

@@ -10,6 +10,10 @@
 
 namespace soft_body_sim::test
 {
+/// Says that the running test is about the divergence guard, so its catches are expected; any other test
+/// that trips the guard fails (test_main.cpp).
+void expectGuardEvents();
+
 /// Asserts |a - b|_inf <= tol and prints both sides on failure.
 template <typename A, typename B>
 ::testing::AssertionResult expectNear(const A& a, const B& b, double tol)

@@ -1,5 +1,6 @@
 #include "soft_body_sim/core/guard.h"
 
+#include <atomic>
 #include <cstdio>
 
 namespace soft_body_sim
@@ -23,6 +24,15 @@ bool guardPolicyFromName(const std::string& name, GuardPolicy& policy)
     }
   return false;
 }
+
+namespace
+{
+std::atomic<std::int64_t> events_in_process{ 0 };
+}  // namespace
+
+std::int64_t divergenceEventsInProcess() { return events_in_process.load(); }
+
+void countDivergenceEventInProcess() { ++events_in_process; }
 
 std::string DivergenceEvent::describe() const
 {

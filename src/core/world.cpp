@@ -174,6 +174,7 @@ void World::guardBodies()
     restored = true;
     ++divergence_count_;
     ++body_divergences_[b];
+    countDivergenceEventInProcess();
     std::string action = treatDiverged(b);
     events_.push_back({ body.name, time(), std::move(reason), std::move(action) });
   }

@@ -4,6 +4,7 @@
 // again.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -61,5 +62,12 @@ struct DivergenceEvent
   /// "body 'rope' diverged at t = 1.250 s (REASON): restored to its last good state, ACTION".
   std::string describe() const;
 };
+
+/// Catches by every World of this process so far (thread-safe). The test harness (test/test_main.cpp)
+/// fails every test that caught one without saying it is about the guard, so that the guard, a safety net
+/// for users, can never turn a bug into a log line that no test reads.
+std::int64_t divergenceEventsInProcess();
+/// Counts one catch in divergenceEventsInProcess (World's guard stage calls it).
+void countDivergenceEventInProcess();
 
 }  // namespace soft_body_sim

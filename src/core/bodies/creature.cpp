@@ -101,16 +101,21 @@ public:
     }
   }
 
-  /// A new target (projected into the swimming plane) starts a move with anticipation at the next update;
-  /// the same target again does not (a topic may repeat it).
+  /// A new target (projected into the swimming plane) steers the lead from the next update on. It starts
+  /// a move with anticipation only if the lead had settled on the previous target and the new one lies
+  /// farther than the settle distance from it (creature.h: streamed targets); the same target again does
+  /// nothing (a topic may repeat it).
   bool setTarget(const Vec3& target) override
   {
     const Vec3 in_plane = toPlane(target);
-    if (in_plane != target_)
-    {
-      target_ = in_plane;
+    if (in_plane == target_)
+      return true;
+    const double settle = def_.settle_tolerance * def_.length;
+    const Vec3& lead = x_[kCreatureLead];
+    const bool settled = (lead - target_).norm() <= settle && (lead - x_previous_[kCreatureLead]).norm() <= settle;
+    if (settled && (in_plane - target_).norm() > settle)
       anticipate_ = true;
-    }
+    target_ = in_plane;
     return true;
   }
 
@@ -240,6 +245,7 @@ BodyDef buildCreature(const std::string& name, const CreatureDef& def)
   check(def.stiffness * def.update_period * def.update_period < 2.0 * (1.0 + def.lead_retention), name,
         "stiffness * update_period^2 must be < 2 (1 + lead_retention) for a stable lead");
   check(def.anticipation >= 0.0, name, "anticipation must be >= 0");
+  check(def.settle_tolerance > 0.0, name, "settle_tolerance must be > 0");
   check(def.iterations >= 1, name, "iterations must be >= 1");
   check(def.min_ratio > 0.0 && def.min_ratio <= 1.0 && def.max_ratio >= 1.0, name,
         "min_ratio must be in (0, 1] and max_ratio >= 1");

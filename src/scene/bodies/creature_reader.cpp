@@ -12,7 +12,7 @@ const Keys kCreatureKeys = { "position",      "heading",        "plane_normal", 
                              "length",        "width",          "update_period",      "stiffness",
                              "lead_retention", "anticipation",  "parallel_retention", "perpendicular_retention",
                              "side_retention", "min_ratio",     "max_ratio",          "soft_strength",
-                             "hard_strength",  "iterations",    "tendrils" };
+                             "hard_strength",  "iterations",    "tendrils",           "settle_tolerance" };
 const Keys kTendrilKeys = { "segments", "length", "mass", "stiffness", "damping", "direction" };
 
 /// A number in [0, 1].
@@ -101,6 +101,8 @@ BodyDef readCreatureBody(const Context& ctx, const Field& field, const SceneSoFa
     def.lead_retention = readFraction(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "anticipation"))
     def.anticipation = readNonNegative(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "settle_tolerance"))
+    def.settle_tolerance = readPositive(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "parallel_retention"))
     def.parallel_retention = readFraction(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "perpendicular_retention"))

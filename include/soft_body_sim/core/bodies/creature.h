@@ -18,6 +18,16 @@
 // `plane_normal` (default +z: a horizontal plane, so that tendrils hang out of it under gravity). Targets
 // are projected into that plane; the side points lie in it, perpendicular to the spine.
 //
+// Anticipation and streamed targets. The seed's antic starts a move: from rest, a new target shifts the
+// lead away by anticipation * (lead - target) before it rushes in. Fired by every new target, it compounds:
+// each antic multiplies the lead's error by (1 + a) and adds that shift as velocity, so targets streamed
+// faster than the lead settles (a planner at 10 to 100 Hz) make the error grow geometrically, by 1.35 per
+// update with the defaults and an antic every update, by 1.1 with one every other update (the spectral
+// radius of the periodic map), until the tendrils hang from points moving at 1e5 m/s. Here an antic fires
+// only from a settled lead (see settle_tolerance): then the shift is at most a (|jump| + s) once, the lead's
+// linear recurrence (stable for k T^2 < 2 (1 + r), r < 1) damps it before another antic can fire, and
+// between antics the lead is that stable filter of the target, so its motion stays bounded for any stream.
+//
 // Nodes: 0 lead, 1 orientation (tail), 2 left side point, 3 right side point ("left" = plane_normal x
 // heading), then the left tendril's nodes from the top down, then the right tendril's. The four body
 // points are pinned and driven by the controller; the tendril nodes are free and move by the integrator.
@@ -56,7 +66,12 @@ struct CreatureDef
   double lead_retention = 0.7;           ///< r: the lead's velocity kept per update, in [0, 1]; the seed's
                                          ///< x' = 1.7 x - 0.7 x_prev + a T^2 is x' = x + r (x - x_prev) + a T^2
   double anticipation = 0.2;             ///< fraction of the distance to a new target by which the lead first
-                                         ///< shifts away from it, >= 0
+                                         ///< shifts away from it, >= 0 (when it fires: see settle_tolerance)
+  double settle_tolerance = 0.02;        ///< [-] fraction of `length`, > 0: a new target starts a move with
+                                         ///< anticipation only if the lead has settled on the previous target
+                                         ///< (within settle_tolerance * length of it and moving less than that
+                                         ///< per update) and the new one lies farther than that from it; a
+                                         ///< target that arrives while the creature swims only steers it
   double parallel_retention = 0.7;       ///< orientation point's velocity kept along the spine per update, [0, 1]
   double perpendicular_retention = 0.5;  ///< ... and across it, in [0, 1]
   double side_retention = 0.5;           ///< side points' velocity kept per update, in [0, 1]
