@@ -2,6 +2,7 @@
 the latest state of a simulator, run the standard command-line clients."""
 import subprocess
 import time
+import unittest
 
 import rospy
 from soft_body_sim.msg import SimState
@@ -29,10 +30,22 @@ def run(*command, timeout=30):
 class StateWatcher:
     """Keeps every SimState of one simulator (stamp -> message) and the latest one."""
 
+    instances = []  # every watcher of this test process, for NodeTestCase's check
+
     def __init__(self, topic="/soft_body_sim/state"):
         self.states = []
         self.latest = None
+        self.expected_events = 0
         self.subscriber = rospy.Subscriber(topic, SimState, self._on_state, queue_size=100)
+        StateWatcher.instances.append(self)
+
+    def expect_guard_events(self):
+        """The divergence guard's catches so far were the test's purpose (and it checked them)."""
+        self.expected_events = self.latest.divergence_events
+
+    def unexpected_guard_events(self):
+        """Catches of the divergence guard that no test expected."""
+        return 0 if self.latest is None else self.latest.divergence_events - self.expected_events
 
     def _on_state(self, message):
         self.states.append(message)
@@ -55,3 +68,14 @@ class StateWatcher:
                 p = b.positions[index]
                 return (p.x, p.y, p.z)
         raise KeyError(body)
+
+
+class NodeTestCase(unittest.TestCase):
+    """A rostest case that fails when the divergence guard of a watched simulator caught a body that the
+    test did not expect (StateWatcher.expect_guard_events): the guard is a safety net for users, and in a
+    test it would turn an explosion into a log line that nobody reads."""
+
+    def tearDown(self):
+        for watcher in StateWatcher.instances:
+            events = watcher.unexpected_guard_events()
+            self.assertEqual(events, 0, f"the divergence guard caught {events} time(s) on {watcher.subscriber.name}")

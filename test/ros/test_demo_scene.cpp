@@ -29,6 +29,13 @@ protected:
     ASSERT_TRUE(waitFor([this] { return state_count_ > 0 && !markers_.markers.empty(); }, 20.0));
   }
 
+  // The divergence guard is a safety net for users; a catch in a test not about it is a bug it would hide.
+  void TearDown() override
+  {
+    ros::spinOnce();
+    EXPECT_EQ(state_.divergence_events, 0u) << "the divergence guard caught a body";
+  }
+
   const BodyState& body(const std::string& name) const
   {
     for (const BodyState& b : state_.bodies)

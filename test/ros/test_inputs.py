@@ -6,7 +6,6 @@ import math
 import os
 import subprocess
 import threading
-import unittest
 
 import roslib.packages
 import rospy
@@ -17,7 +16,7 @@ from rosgraph_msgs.msg import Log
 from std_srvs.srv import SetBool
 from visualization_msgs.msg import InteractiveMarkerFeedback, InteractiveMarkerInit
 
-from node_client import StateWatcher, wait_for
+from node_client import NodeTestCase, StateWatcher, wait_for
 from soft_body_sim.srv import Attach, Detach
 
 NODE = "/soft_body_sim"
@@ -32,7 +31,7 @@ def gripper_position(t):
             GRIPPER_CENTER[2] + GRIPPER_RADIUS * math.sin(w * t))
 
 
-class InputsTest(unittest.TestCase):
+class InputsTest(NodeTestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_inputs")

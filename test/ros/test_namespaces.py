@@ -2,7 +2,6 @@
 """Two simulators side by side (launched by namespaces.test): /a runs node_test_scene.yaml (a 5-node
 rope with anchors start and end), /b config/scenes/rope.yaml (a 21-node rope with anchors left and
 right). Both bodies are called rope; what is done to one must not reach the other."""
-import unittest
 
 import dynamic_reconfigure.client
 import rospy
@@ -11,7 +10,7 @@ from geometry_msgs.msg import PoseStamped
 from std_srvs.srv import Empty, SetBool
 from visualization_msgs.msg import InteractiveMarkerInit
 
-from node_client import StateWatcher, wait_for
+from node_client import NodeTestCase, StateWatcher, wait_for
 
 
 def pose(x, y, z):
@@ -22,7 +21,7 @@ def pose(x, y, z):
     return message
 
 
-class NamespacesTest(unittest.TestCase):
+class NamespacesTest(NodeTestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_namespaces")

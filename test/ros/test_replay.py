@@ -20,7 +20,6 @@ import signal
 import subprocess
 import tempfile
 import time
-import unittest
 
 import rosbag
 import rosgraph
@@ -28,7 +27,7 @@ import rospy
 import rostest
 from geometry_msgs.msg import PoseStamped
 
-from node_client import StateWatcher, wait_for
+from node_client import NodeTestCase, StateWatcher, wait_for
 
 SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "replay_test_scene.yaml")
 NODE = "/soft_body_sim"
@@ -76,7 +75,7 @@ def values(state):
     return [(p.x, p.y, p.z, v.x, v.y, v.z) for body in state.bodies for p, v in zip(body.positions, body.velocities)]
 
 
-class ReplayTest(unittest.TestCase):
+class ReplayTest(NodeTestCase):
     def setUp(self):
         self.folder = tempfile.mkdtemp(prefix="soft_body_sim_replay_")
         self.processes = {}  # name -> a process still wanted

@@ -3,18 +3,17 @@
 driven around a circle of 0.25 m about (-6.75, 0, 1.5) in the x-z plane, one turn in 4 s, and the
 codeling's target along a figure eight about (3.6, 0, 1.2)."""
 import math
-import unittest
 
 import rospy
 import rostest
 
-from node_client import StateWatcher
+from node_client import NodeTestCase, StateWatcher
 
 CENTER = (-6.75, 0.0, 1.5)
 RADIUS = 0.25
 
 
-class SendTargetsTest(unittest.TestCase):
+class SendTargetsTest(NodeTestCase):
     def test_the_anchor_circles_and_the_creature_swims(self):
         rospy.init_node("test_send_targets")
         state = StateWatcher()

@@ -115,6 +115,13 @@ protected:
     ASSERT_TRUE(waitFor([this] { return start_pub_.getNumSubscribers() > 0 && end_pub_.getNumSubscribers() > 0; }, 10.0));
   }
 
+  // The divergence guard is a safety net for users; a catch in a test not about it is a bug it would hide.
+  void TearDown() override
+  {
+    ros::spinOnce();
+    EXPECT_EQ(state_.divergence_events, 0u) << "the divergence guard caught a body";
+  }
+
   /// Waits for `count` more state messages.
   void nextStates(int count)
   {

@@ -4,7 +4,6 @@ health on /diagnostics (launched by tuning.test on test/ros/node_test_scene.yaml
 k = 50 N/m, 0.01 kg per node, hanging from both anchored ends, dt = 1 ms, semi_implicit_euler)."""
 import ast
 import math
-import unittest
 
 import dynamic_reconfigure.client
 import rospy
@@ -15,7 +14,7 @@ from dynamic_reconfigure.srv import Reconfigure
 from rosgraph_msgs.msg import Log
 from std_srvs.srv import Empty
 
-from node_client import StateWatcher, run, wait_for
+from node_client import NodeTestCase, StateWatcher, run, wait_for
 
 NODE = "/soft_body_sim"
 
@@ -45,7 +44,7 @@ SCENE_PHYSICS = {"integrator": "semi_implicit_euler", "dt": 0.001, "substeps": 1
 UNSCALED = {"stiffness_scale": 1.0, "damping_scale": 1.0, "pressure_scale": 1.0}
 
 
-class TuningTest(unittest.TestCase):
+class TuningTest(NodeTestCase):
     @classmethod
     def setUpClass(cls):
         rospy.init_node("test_tuning")
@@ -165,6 +164,7 @@ class TuningTest(unittest.TestCase):
         rope = self.state.next(5).bodies[0]
         self.assertEqual((rope.integrator, rope.divergence_events, rope.frozen), ("implicit_euler", 1, False))
         self.assertEqual(self.state.latest.divergence_events, events + 1)
+        self.state.expect_guard_events()
         for state in self.state.states:
             for p in state.bodies[0].positions:
                 self.assertTrue(all(map(math.isfinite, (p.x, p.y, p.z))))
