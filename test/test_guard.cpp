@@ -3,6 +3,7 @@
 // symplectic Euler, each scheme's exact discrete parabola, and the same body run alone.
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -151,6 +152,52 @@ TEST(Guard, HalveStepFreezesABodyThatDivergesAtEveryStep)
   const std::vector<DivergenceEvent> events = world.takeDivergenceEvents();
   ASSERT_EQ(events.size(), 11u);
   EXPECT_EQ(events.back().action, "already at 1024 sub-steps per step: frozen (its free nodes pinned at rest)");
+}
+
+/// Drives its node away ever faster: its position doubles every step (a controller gone wrong).
+class RunawayController final : public Controller
+{
+public:
+  explicit RunawayController(int node) : node_(node) {}
+  void step(double dt, State& state) override
+  {
+    const Vec3 next = 2.0 * Vec3(state.position.col(node_));
+    state.velocity.col(node_) = (next - state.position.col(node_)) / dt;
+    state.position.col(node_) = next;
+  }
+
+private:
+  int node_;
+};
+
+TEST(Guard, AFrozenBodysControllerStopsToo)
+{
+  // A free node hangs on a spring from a node that a runaway controller drives: the free node is dragged
+  // past max_speed, the guard freezes the body, and from then on the driven node stands still too. Left
+  // running, the controller would reach infinity (2^1024) within about a thousand steps.
+  expectGuardEvents();  // about the guard's freeze
+  BodyDef body;
+  body.name = "runaway";
+  body.nodes = { { Vec3(1, 0, 0), 1.0, Vec3::Zero(), true }, { Vec3(1, 0, -1), 1.0, Vec3::Zero(), false } };
+  body.springs = { { 0, 1, 100.0, 0.0, 1.0 } };
+  body.controller = [](int first_node) { return std::make_unique<RunawayController>(first_node); };
+  World world = buildWorld(scene(IntegratorType::ImplicitEuler, 0.01, GuardPolicy::Freeze, { body }));
+  int steps_to_freeze = 0;
+  while (!world.isFrozen(0) && steps_to_freeze < 100)
+  {
+    world.step();
+    ++steps_to_freeze;
+  }
+  ASSERT_TRUE(world.isFrozen(0));
+  const Vec3 driven = world.state().position.col(0);
+  for (int n = 0; n < 2000; ++n)
+  {
+    world.step();
+    ASSERT_TRUE(allFinite(world.state())) << "step " << n;
+    ASSERT_TRUE(expectNear(Vec3(world.state().position.col(0)), driven, 0.0)) << "step " << n;
+    ASSERT_TRUE(expectNear(Vec3(world.state().velocity.col(0)), Vec3::Zero(), 0.0)) << "step " << n;
+  }
+  EXPECT_EQ(world.divergenceCount(), 1);
 }
 
 TEST(Guard, FreezeStopsTheBodyWhileAnotherFallsOnItsExactParabola)

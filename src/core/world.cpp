@@ -254,11 +254,13 @@ std::string World::freeze(std::size_t body)
   frozen_[body] = 1;
   const BodyRange& range = model_.bodies[body];
   for (int i = range.first; i < range.first + range.count; ++i)
+  {
+    // Its controller stops too (driveKinematicNodes): a controller whose own points run away (as the
+    // codeling's compounding antic once did) would otherwise drag the frozen body on to infinity.
+    state_.velocity.col(i).setZero();
     if (model_.isFree(i))
-    {
       model_.inverse_mass[i] = 0.0;
-      state_.velocity.col(i).setZero();
-    }
+  }
   modelChanged();
   return "frozen (its free nodes pinned at rest)";
 }
@@ -267,7 +269,8 @@ bool World::driveKinematicNodes(double dt)
 {
   bool moved = !controllers_.empty();
   for (BodyController& body : controllers_)
-    body.controller->step(dt, state_);
+    if (!frozen_[static_cast<std::size_t>(body.body)])  // a frozen body stands still, driven points too
+      body.controller->step(dt, state_);
   for (std::size_t k = 0; k < model_.anchors.size(); ++k)
   {
     const int node = model_.anchors[k].node;

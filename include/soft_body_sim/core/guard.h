@@ -21,7 +21,8 @@ enum class GuardPolicy
   /// springs, and the one scheme here without a step limit of its own (xpbd's direct chain solve has
   /// one). A body already on implicit_euler is frozen instead.
   SwitchIntegrator,
-  /// Pin the body's free nodes where they are, at rest. The rest of the scene goes on.
+  /// Pin the body's free nodes where they are, at rest, and stop its controller (if any), so that the
+  /// body stands still; its anchors still move their nodes. The rest of the scene goes on.
   Freeze,
 };
 
