@@ -19,7 +19,7 @@ from PIL import Image, ImageGrab
 # The demo scene's bodies in file order (= body index = colour) and so from left to right.
 BODIES = ["rope", "string", "jelly", "cloth", "codeling", "figure"]
 HUE_TOLERANCE = 8.0   # [deg] lighting changes value and saturation of the flat colours, hardly the hue
-MIN_PIXELS = 40       # a body covers at least this many pixels of its colour in a 1200 x 800 view
+MIN_PIXELS = 40       # a body covers at least this many pixels of its colour in the 1920 x 620 view
 
 
 def body_hue(index):
@@ -88,7 +88,7 @@ class RvizScreenshotTest(unittest.TestCase):
 
     def test_every_body_is_visible_in_its_colour_and_place(self):
         display = free_display()
-        self.start(["Xvfb", display, "-screen", "0", "1280x860x24", "-nolisten", "tcp"])
+        self.start(["Xvfb", display, "-screen", "0", "1920x620x24", "-nolisten", "tcp"])
         env = dict(os.environ, DISPLAY=display, LIBGL_ALWAYS_SOFTWARE="1")
         deadline = time.monotonic() + 20.0
         while not os.path.exists(f"/tmp/.X11-unix/X{display[1:]}") and time.monotonic() < deadline:
