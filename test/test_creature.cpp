@@ -401,6 +401,7 @@ bodies:
     stiffness: 30.0
     lead_retention: 0.75
     anticipation: 0.25
+    settle_tolerance: 2.0
     parallel_retention: 0.65
     perpendicular_retention: 0.45
     side_retention: 0.55
@@ -425,6 +426,7 @@ CreatureDef allKeysDef()
   def.stiffness = 30.0;
   def.lead_retention = 0.75;
   def.anticipation = 0.25;
+  def.settle_tolerance = 2.0;  // 0.5 m: "settled" while still swimming, so the 0.58 m jump anticipates
   def.parallel_retention = 0.65;
   def.perpendicular_retention = 0.45;
   def.side_retention = 0.55;
@@ -510,6 +512,7 @@ TEST(CreatureScene, BadValuesAreRejectedWithOneLineAtTheKey)
   expectSceneError(creatureWith("stiffness: 5000"), at + "stiffness", { "stable" });
   expectSceneError(creatureWith("lead_retention: 1.5"), at + "lead_retention", { "[0, 1]" });
   expectSceneError(creatureWith("anticipation: -0.2"), at + "anticipation", { ">= 0" });
+  expectSceneError(creatureWith("settle_tolerance: 0"), at + "settle_tolerance", { "> 0" });
   expectSceneError(creatureWith("parallel_retention: -0.1"), at + "parallel_retention", { ">= 0" });
   expectSceneError(creatureWith("perpendicular_retention: 2"), at + "perpendicular_retention", { "[0, 1]" });
   expectSceneError(creatureWith("side_retention: 1.01"), at + "side_retention", { "[0, 1]" });
