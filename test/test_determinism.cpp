@@ -1,0 +1,229 @@
+// Today's results, pinned bit for bit (as Box2D's test/test_determinism.c pins a state hash): every
+// example scene and every hard-case scene, with each integrator that its step keeps stable, runs a fixed
+// number of steps while its anchors follow a small circle and its targets jump once; then a hash of the
+// exact bits of every position and velocity must equal the value pinned below. A refactor keeps every
+// value. A change that alters results on purpose updates the table in the same commit and says why:
+// SOFT_BODY_SIM_PRINT_HASHES=1 prints the table as the build computes it. The hashes hold for this
+// compiler and flags (g++ 12, the Release build's -O3, x86-64 without -march): the sanitizer build does not
+// run this test.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "soft_body_sim/core/stability.h"
+#include "soft_body_sim/scene/scene_loader.h"
+#include "test_util.h"
+
+namespace soft_body_sim::test
+{
+namespace
+{
+constexpr int kSteps = 240;
+/// Node-steps per run at most: the 100,000-node cloth runs 2 steps (implicit_euler takes ~5 s a step
+/// there), every other scene all kSteps.
+constexpr double kNodeSteps = 3.0e5;
+
+struct Pinned
+{
+  const char* scene;       ///< path from the package root
+  const char* integrator;  ///< scene-file name
+  std::uint64_t hash;
+};
+
+// clang-format off
+const std::vector<Pinned> kPinned = {
+  { "config/scenes/cloth.yaml", "rk4", 0x24aab8b58412399eULL },
+  { "config/scenes/cloth.yaml", "implicit_euler", 0xd44b7f91a51c3065ULL },
+  { "config/scenes/cloth.yaml", "xpbd", 0x4bb109f3abb4c01dULL },
+  { "config/scenes/creature.yaml", "semi_implicit_euler", 0x10b8eff17b388facULL },
+  { "config/scenes/creature.yaml", "verlet", 0x8b3e1a86c151235ULL },
+  { "config/scenes/creature.yaml", "velocity_verlet", 0xd7c6209b2b442118ULL },
+  { "config/scenes/creature.yaml", "rk4", 0x4aa0ff5b90f3abafULL },
+  { "config/scenes/creature.yaml", "implicit_euler", 0xdd1b2b126654211bULL },
+  { "config/scenes/creature.yaml", "xpbd", 0x4cc3d2920fde0bf4ULL },
+  { "config/scenes/demo.yaml", "rk4", 0x2414909d02339c23ULL },
+  { "config/scenes/demo.yaml", "implicit_euler", 0x9451880ada802098ULL },
+  { "config/scenes/demo.yaml", "xpbd", 0x763c2bd10602a404ULL },
+  { "config/scenes/hanging_chain.yaml", "implicit_euler", 0xfe12873371da025cULL },
+  { "config/scenes/hanging_chain.yaml", "xpbd", 0xe92b1e0ea449cc14ULL },
+  { "config/scenes/humanoid.yaml", "explicit_euler", 0xc3ca3b1f594e318bULL },
+  { "config/scenes/humanoid.yaml", "semi_implicit_euler", 0xc3ca3b1f594e318bULL },
+  { "config/scenes/humanoid.yaml", "verlet", 0xc3ca3b1f594e318bULL },
+  { "config/scenes/humanoid.yaml", "velocity_verlet", 0xc3ca3b1f594e318bULL },
+  { "config/scenes/humanoid.yaml", "rk4", 0xc3ca3b1f594e318bULL },
+  { "config/scenes/humanoid.yaml", "implicit_euler", 0xc3ca3b1f594e318bULL },
+  { "config/scenes/humanoid.yaml", "xpbd", 0xc3ca3b1f594e318bULL },
+  { "config/scenes/jelly.yaml", "semi_implicit_euler", 0x313d8f5d0b13418dULL },
+  { "config/scenes/jelly.yaml", "verlet", 0x1fbac4413dc07f77ULL },
+  { "config/scenes/jelly.yaml", "velocity_verlet", 0xab71efd8c0f440c6ULL },
+  { "config/scenes/jelly.yaml", "rk4", 0x2d57f2f8e08e422ULL },
+  { "config/scenes/jelly.yaml", "implicit_euler", 0x155ea0a7df6aec1eULL },
+  { "config/scenes/jelly.yaml", "xpbd", 0x1ba83e59eac5aa37ULL },
+  { "config/scenes/limb.yaml", "explicit_euler", 0x209a46a387d07860ULL },
+  { "config/scenes/limb.yaml", "semi_implicit_euler", 0x209a46a387d07860ULL },
+  { "config/scenes/limb.yaml", "verlet", 0x209a46a387d07860ULL },
+  { "config/scenes/limb.yaml", "velocity_verlet", 0x209a46a387d07860ULL },
+  { "config/scenes/limb.yaml", "rk4", 0x209a46a387d07860ULL },
+  { "config/scenes/limb.yaml", "implicit_euler", 0x209a46a387d07860ULL },
+  { "config/scenes/limb.yaml", "xpbd", 0x209a46a387d07860ULL },
+  { "config/scenes/rope.yaml", "semi_implicit_euler", 0x432708fdcb453faeULL },
+  { "config/scenes/rope.yaml", "verlet", 0x5a08e6e9504bb69eULL },
+  { "config/scenes/rope.yaml", "velocity_verlet", 0x9a532fbadfdd1d06ULL },
+  { "config/scenes/rope.yaml", "rk4", 0xb376e8c44ec1dc48ULL },
+  { "config/scenes/rope.yaml", "implicit_euler", 0xdc062f4fe900b01cULL },
+  { "config/scenes/rope.yaml", "xpbd", 0xbbaaa9e1d808950aULL },
+  { "config/scenes/string.yaml", "semi_implicit_euler", 0x79888fa982599fd2ULL },
+  { "config/scenes/string.yaml", "verlet", 0xda0722758942fe02ULL },
+  { "config/scenes/string.yaml", "velocity_verlet", 0xf411c4160f68ad26ULL },
+  { "config/scenes/string.yaml", "rk4", 0xb6dc2774eba0f2c8ULL },
+  { "config/scenes/string.yaml", "implicit_euler", 0x9df7cdfe5e44af0aULL },
+  { "config/scenes/string.yaml", "xpbd", 0x5f6992a083643df9ULL },
+  { "config/scenes/tum_exercise_1.yaml", "semi_implicit_euler", 0x82700039e4eee349ULL },
+  { "config/scenes/tum_exercise_1.yaml", "verlet", 0xbdad82fe9c131ba6ULL },
+  { "config/scenes/tum_exercise_1.yaml", "velocity_verlet", 0x72eb70d3cfdcb969ULL },
+  { "config/scenes/tum_exercise_1.yaml", "rk4", 0x4fbe47d500f9d3faULL },
+  { "config/scenes/tum_exercise_1.yaml", "implicit_euler", 0xd8de47960d2555aULL },
+  { "config/scenes/tum_exercise_1.yaml", "xpbd", 0x5e2320c1b686eba7ULL },
+  { "test/hard_cases/anchor_teleport.yaml", "semi_implicit_euler", 0x778c14c172ab944ULL },
+  { "test/hard_cases/anchor_teleport.yaml", "verlet", 0x7a79f775389aed69ULL },
+  { "test/hard_cases/anchor_teleport.yaml", "velocity_verlet", 0x8fc001f786061bcaULL },
+  { "test/hard_cases/anchor_teleport.yaml", "rk4", 0x16b1ba1debbb9369ULL },
+  { "test/hard_cases/anchor_teleport.yaml", "implicit_euler", 0x9b6ae15d67a07740ULL },
+  { "test/hard_cases/anchor_teleport.yaml", "xpbd", 0x95f85a7705aa2ce4ULL },
+  { "test/hard_cases/damping_threshold.yaml", "implicit_euler", 0x82b2bfb8e1b93444ULL },
+  { "test/hard_cases/damping_threshold.yaml", "xpbd", 0x4c9296c1d78a2d48ULL },
+  { "test/hard_cases/heavy_end_chain.yaml", "implicit_euler", 0x58dc3499b2ce3343ULL },
+  { "test/hard_cases/heavy_end_chain.yaml", "xpbd", 0x745ca989beffb9cfULL },
+  { "test/hard_cases/jelly_drop_5m.yaml", "semi_implicit_euler", 0xf253f67967e8f176ULL },
+  { "test/hard_cases/jelly_drop_5m.yaml", "verlet", 0xf80adb69511d694cULL },
+  { "test/hard_cases/jelly_drop_5m.yaml", "velocity_verlet", 0x8f0839856f3af7ceULL },
+  { "test/hard_cases/jelly_drop_5m.yaml", "rk4", 0xc641388d56946a5bULL },
+  { "test/hard_cases/jelly_drop_5m.yaml", "implicit_euler", 0x1503ff1b59ed9bcbULL },
+  { "test/hard_cases/jelly_drop_5m.yaml", "xpbd", 0x605ef59fb8b471c0ULL },
+  { "test/hard_cases/large_cloth.yaml", "implicit_euler", 0x5c9fbad9b4565031ULL },
+  { "test/hard_cases/large_cloth.yaml", "xpbd", 0x226234149caf26e3ULL },
+  { "test/hard_cases/mass_extremes.yaml", "implicit_euler", 0xc05553a56e45c423ULL },
+  { "test/hard_cases/mass_extremes.yaml", "xpbd", 0x772777461c4ca368ULL },
+  { "test/hard_cases/single_node.yaml", "explicit_euler", 0xd4e5626257b9ea0dULL },
+  { "test/hard_cases/single_node.yaml", "semi_implicit_euler", 0x47cb06fa2724ff8aULL },
+  { "test/hard_cases/single_node.yaml", "verlet", 0x6a45dcac8ea4439dULL },
+  { "test/hard_cases/single_node.yaml", "velocity_verlet", 0xc39148cf5b936566ULL },
+  { "test/hard_cases/single_node.yaml", "rk4", 0x1e2eda21cd7b87a1ULL },
+  { "test/hard_cases/single_node.yaml", "implicit_euler", 0x47cb06fa2724ff8aULL },
+  { "test/hard_cases/single_node.yaml", "xpbd", 0x56cf232357ebaa46ULL },
+  { "test/hard_cases/stiff_spring.yaml", "semi_implicit_euler", 0x566ead3644e6562fULL },
+  { "test/hard_cases/stiff_spring.yaml", "verlet", 0x3f7414d88df53eb6ULL },
+  { "test/hard_cases/stiff_spring.yaml", "velocity_verlet", 0x7dfab0fa78ffc06dULL },
+  { "test/hard_cases/stiff_spring.yaml", "rk4", 0x4c4d748ca8754919ULL },
+  { "test/hard_cases/stiff_spring.yaml", "implicit_euler", 0xd55a0013138e489ULL },
+  { "test/hard_cases/stiff_spring.yaml", "xpbd", 0xc6ced583348c4f18ULL },
+  { "test/hard_cases/zero_rest_length.yaml", "explicit_euler", 0x200eeb692b8cc6a1ULL },
+  { "test/hard_cases/zero_rest_length.yaml", "semi_implicit_euler", 0x3fa89ee2abc1e10eULL },
+  { "test/hard_cases/zero_rest_length.yaml", "verlet", 0xd581c34593436b48ULL },
+  { "test/hard_cases/zero_rest_length.yaml", "velocity_verlet", 0x2d278297bb773dcaULL },
+  { "test/hard_cases/zero_rest_length.yaml", "rk4", 0x4bb20dff05583adfULL },
+  { "test/hard_cases/zero_rest_length.yaml", "implicit_euler", 0x14d1a43650994275ULL },
+  { "test/hard_cases/zero_rest_length.yaml", "xpbd", 0xc9dd1899635e2f63ULL },
+};
+// clang-format on
+
+/// FNV-1a over the bytes of the doubles of `array`, chained from `hash`.
+std::uint64_t fnv1a(const NodeArray& array, std::uint64_t hash)
+{
+  const auto* bytes = reinterpret_cast<const unsigned char*>(array.data());
+  const std::size_t size = static_cast<std::size_t>(array.size()) * sizeof(double);
+  for (std::size_t k = 0; k < size; ++k)
+  {
+    hash ^= bytes[k];
+    hash *= 1099511628211ULL;
+  }
+  return hash;
+}
+
+std::vector<std::string> scenes()
+{
+  std::vector<std::string> paths;
+  for (const char* folder : { "config/scenes", "test/hard_cases" })
+    for (const auto& entry : std::filesystem::directory_iterator(std::string(SOURCE_DIR) + "/" + folder))
+      if (entry.path().extension() == ".yaml")
+        paths.push_back(std::string(folder) + "/" + entry.path().filename().string());
+  std::sort(paths.begin(), paths.end());
+  return paths;
+}
+
+/// The hash after kSteps steps (fewer for a large scene, see kNodeSteps) of `scene` with `integrator`:
+/// anchors circle (radius 5 cm, one turn in 2 s, from where they start) for the first half; every body
+/// that takes a target is sent 0.3 m along x at step 60.
+std::uint64_t run(const SceneDef& scene, IntegratorType integrator)
+{
+  SceneDef with = scene;
+  with.physics.integrator = integrator;
+  World world = buildWorld(with);
+  const int steps = std::min(kSteps, static_cast<int>(kNodeSteps / world.model().nodeCount()));
+  std::vector<Vec3> anchor_start;
+  for (const Anchor& anchor : world.model().anchors)
+    anchor_start.push_back(world.state().position.col(anchor.node));
+  for (int n = 0; n < steps; ++n)
+  {
+    if (n < steps / 2)
+      for (std::size_t k = 0; k < anchor_start.size(); ++k)
+      {
+        const double angle = M_PI * world.time();
+        world.moveAnchor(static_cast<int>(k), anchor_start[k] + 0.05 * Vec3(std::cos(angle) - 1.0, 0.0, std::sin(angle)));
+      }
+    if (n == 60)
+      for (const BodyRange& body : world.model().bodies)
+        world.setTarget(body.name, Vec3(world.state().position.col(body.first)) + Vec3(0.3, 0.0, 0.0));
+    world.step();
+  }
+  return fnv1a(world.state().velocity, fnv1a(world.state().position, 14695981039346656037ULL));
+}
+
+TEST(Determinism, EveryExampleAndHardCaseSceneGivesItsPinnedBits)
+{
+  const bool print = std::getenv("SOFT_BODY_SIM_PRINT_HASHES") != nullptr;
+  std::size_t checked = 0;
+  for (const std::string& path : scenes())
+  {
+    const SceneDef scene = loadSceneFile(std::string(SOURCE_DIR) + "/" + path);
+    for (const std::string& name : integratorNames())
+    {
+      IntegratorType integrator;
+      ASSERT_TRUE(integratorFromName(name, integrator));
+      SceneDef with = scene;
+      with.physics.integrator = integrator;
+      {
+        const World probe = buildWorld(with);
+        if (!stabilityWarnings(probe.model(), probe.state(), integrator, probe.settings()).empty())
+          continue;
+      }
+      const std::uint64_t hash = run(scene, integrator);
+      if (print)
+      {
+        std::cout << "  { \"" << path << "\", \"" << name << "\", 0x" << std::hex << hash << std::dec << "ULL },\n";
+        continue;
+      }
+      const auto pinned = std::find_if(kPinned.begin(), kPinned.end(), [&](const Pinned& p) {
+        return path == p.scene && name == p.integrator;
+      });
+      ASSERT_NE(pinned, kPinned.end()) << path << " with " << name << " has no pinned hash";
+      EXPECT_EQ(hash, pinned->hash) << path << " with " << name;
+      ++checked;
+    }
+  }
+  if (!print)
+  {
+    EXPECT_EQ(checked, kPinned.size()) << "a pinned scene or integrator no longer runs";
+  }
+}
+
+}  // namespace
+}  // namespace soft_body_sim::test
