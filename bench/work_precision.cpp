@@ -287,8 +287,6 @@ int run(int argc, char** argv)
     std::vector<std::pair<Config, std::function<std::unique_ptr<Engine>()>>> runs;
     for (const Config& config : problem.sweep)
       runs.emplace_back(config, [&problem, config]() -> std::unique_ptr<Engine> {
-        if (problem.probe)
-          return std::make_unique<ProbeEngine>(problem.scene(config));
         return std::make_unique<PackageEngine>(problem.scene(config));
       });
     if (problem.bullet && use_bullet && bulletAvailable())

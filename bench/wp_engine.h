@@ -2,6 +2,7 @@
 // its node positions, whichever engine runs it (this package's World, or Bullet's soft bodies).
 #pragma once
 
+#include <algorithm>
 #include <ctime>
 #include <limits>
 #include <memory>
@@ -45,42 +46,28 @@ public:
   virtual double penetration() { return 0.0; }
 };
 
-/// This package: World::step, exactly as a user runs it.
+/// This package: World::step, exactly as a user runs it. Where the scene has planes, it also observes
+/// the step between integration and contact (World::observeIntegration) for the penetration.
 class PackageEngine final : public Engine
 {
 public:
-  explicit PackageEngine(const SceneDef& scene) : world_(buildWorld(scene)) {}
+  explicit PackageEngine(const SceneDef& scene) : world_(buildWorld(scene))
+  {
+    if (!world_.model().planes.empty())
+      world_.observeIntegration([this](const Model& model, const State& state) {
+        for (const Plane& plane : model.planes)
+          for (Eigen::Index i = 0; i < state.position.cols(); ++i)
+            penetration_ = std::max(penetration_, -(state.position.col(i) - plane.point).dot(plane.normal));
+      });
+  }
   void step() override { world_.step(); }
   const Eigen::Matrix3Xd& positions() override { return world_.state().position; }
   double energy() override { return world_.energy(); }
+  double penetration() override { return penetration_; }
   const World& world() const { return world_; }
 
 private:
   World world_;
-};
-
-/// The stages of World::step for a scene without anchors or controllers (integrator, then planes, per
-/// sub-step), run by hand so that the depth of a node behind a plane can be read between the two: the
-/// contact pass leaves every node on or above its plane, so after a step the penetration is always 0.
-/// checkAgainstWorld() confirms that it steps bit-identically to World.
-class ProbeEngine final : public Engine
-{
-public:
-  explicit ProbeEngine(const SceneDef& scene);
-  void step() override;
-  const Eigen::Matrix3Xd& positions() override { return state_.position; }
-  double energy() override;
-  double penetration() override { return penetration_; }
-
-  /// True if `steps` steps of this engine and of World give bit-identical positions.
-  static bool checkAgainstWorld(const SceneDef& scene, int steps);
-
-private:
-  Model model_;
-  State state_;
-  StepSettings settings_;
-  std::unique_ptr<Integrator> integrator_;
-  std::vector<std::uint8_t> touching_;
   double penetration_ = 0.0;
 };
 

@@ -43,7 +43,6 @@ struct Problem
   double duration = 1.0;      ///< [s] simulated per run
   double sample_period = 0;   ///< [s]; 0 = errors only at the end of the run
   std::vector<std::string> error_kinds;
-  bool probe = false;         ///< run by ProbeEngine (penetration inside a sub-step)
   std::function<SceneDef(const Config&)> scene;
   std::function<std::unique_ptr<Meter>()> meter;
   std::vector<Config> sweep;             ///< this package's configurations

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "soft_body_sim/core/contact.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
@@ -17,5 +18,21 @@ namespace soft_body_sim
 /// floor, alone or under the weight of others, gains approach speed every step and must not jitter.
 /// Returns true if any node was touched.
 bool collideWithPlanes(const Model& model, State& state, double resting_speed, std::vector<std::uint8_t>& touching);
+
+/// Model::planes as a kind of collider of the contact stage.
+class PlaneContacts final : public ColliderKind
+{
+public:
+  explicit PlaneContacts(int nodes) : touching_(static_cast<std::size_t>(nodes), 0) {}
+
+  /// A node resting on a plane approaches it by ~|g| h per sub-step; twice that does not bounce.
+  bool resolve(const Model& model, State& state, double h) override
+  {
+    return collideWithPlanes(model, state, 2.0 * model.gravity.norm() * h, touching_);
+  }
+
+private:
+  std::vector<std::uint8_t> touching_;  ///< per node: on a plane after the last sub-step
+};
 
 }  // namespace soft_body_sim

@@ -4,9 +4,12 @@
 // again.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
 {
@@ -64,11 +67,59 @@ struct DivergenceEvent
   std::string describe() const;
 };
 
+/// The guard's memory: the last good state, which bodies it froze, what it caught. The world runs it as
+/// the last stage of a step (World::guardBodies) and applies the policy to each body it caught.
+class DivergenceGuard
+{
+public:
+  DivergenceGuard(const State& initial, std::size_t bodies);
+
+  /// Throws std::invalid_argument if max_speed is not a finite number > 0.
+  void setSettings(const GuardSettings& settings);
+  const GuardSettings& settings() const { return settings_; }
+
+  /// A body caught diverging, and why.
+  struct Catch
+  {
+    std::size_t body;
+    std::string reason;
+  };
+  /// Stage: every body that is not frozen and has a non-finite or too fast free node gets its free nodes
+  /// back from the last good state (pinned ones belong to the anchors and controllers, which moved them
+  /// on purpose). Returns those bodies, for the world to treat by the policy and then record().
+  std::vector<Catch> restoreDiverged(const Model& model, State& state) const;
+  /// Counts a catch and keeps its event for takeEvents().
+  void record(const Model& model, const Catch& caught, double time, std::string action);
+  /// Saves `state` as the last good one after a catch and every kGuardCheckpointSteps steps.
+  void checkpoint(const State& state, std::int64_t step, bool caught);
+
+  /// Pins body `body`'s free nodes at rest and stops its controller (World::driveKinematicNodes asks
+  /// isFrozen). Returns what it did, for the event.
+  std::string freeze(Model& model, State& state, std::size_t body);
+  bool isFrozen(std::size_t body) const { return frozen_.at(body) != 0; }
+
+  std::int64_t count() const { return count_; }
+  std::int64_t count(std::size_t body) const { return body_counts_.at(body); }
+  /// The catches since the last call, oldest first.
+  std::vector<DivergenceEvent> takeEvents();
+
+private:
+  /// True if body `body` is certainly fine (false says: look closer).
+  bool looksGood(const State& state, const BodyRange& body) const;
+  /// Why the body counts as diverged now, or empty.
+  std::string divergence(const Model& model, const State& state, const BodyRange& body) const;
+
+  GuardSettings settings_;
+  State last_good_;                        ///< saved every kGuardCheckpointSteps steps and after a catch
+  std::vector<std::uint8_t> frozen_;       ///< per body
+  std::vector<std::int64_t> body_counts_;  ///< per body
+  std::int64_t count_ = 0;
+  std::vector<DivergenceEvent> events_;    ///< not yet taken
+};
+
 /// Catches by every World of this process so far (thread-safe). The test harness (test/test_main.cpp)
 /// fails every test that caught one without saying it is about the guard, so that the guard, a safety net
 /// for users, can never turn a bug into a log line that no test reads.
 std::int64_t divergenceEventsInProcess();
-/// Counts one catch in divergenceEventsInProcess (World's guard stage calls it).
-void countDivergenceEventInProcess();
 
 }  // namespace soft_body_sim

@@ -2,6 +2,8 @@
 // Header of the ROS-free core: Eigen and the standard library only.
 #pragma once
 
+#include <cstddef>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -91,6 +93,14 @@ struct Model
 
   int nodeCount() const { return static_cast<int>(mass.size()); }
   bool isFree(int i) const { return inverse_mass[i] > 0.0; }
+  /// Index into `bodies` of the body holding node `node`; throws std::out_of_range if none does.
+  std::size_t bodyOf(int node) const
+  {
+    for (std::size_t b = 0; b < bodies.size(); ++b)
+      if (node >= bodies[b].first && node < bodies[b].first + bodies[b].count)
+        return b;
+    throw std::out_of_range("Model: node " + std::to_string(node) + " belongs to no body");
+  }
 };
 
 /// Where the scene is now.

@@ -8,9 +8,13 @@
 #include <string>
 #include <vector>
 
+#include "soft_body_sim/core/anchors.h"
+#include "soft_body_sim/core/contact.h"
 #include "soft_body_sim/core/controller.h"
 #include "soft_body_sim/core/guard.h"
 #include "soft_body_sim/core/integrator.h"
+#include "soft_body_sim/core/integrator_groups.h"
+#include "soft_body_sim/core/material.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
@@ -22,17 +26,8 @@ struct BodyController
   std::unique_ptr<Controller> controller;
 };
 
-/// Live multipliers of one body's material, relative to the scene's values (the jelly seed's sliders
-/// "to make it more springy or viscous"). 1 = as loaded; each > 0.
-struct BodyScaling
-{
-  double stiffness = 1.0;  ///< [-] spring stiffness k, and constraint stiffness 1 / compliance
-  double damping = 1.0;    ///< [-] spring dashpots c
-  double pressure = 1.0;   ///< [-] rest gas pressure p0 of the body's cells
-};
-
-/// Where an anchor should be at simulated time t [s]; nullopt leaves it where it is.
-using AnchorPath = std::function<std::optional<Vec3>(double t)>;
+/// Looks at the state between two stages of a step (World::observeIntegration).
+using StateObserver = std::function<void(const Model& model, const State& state)>;
 
 class World
 {
@@ -41,9 +36,7 @@ public:
   World(Model model, State initial, IntegratorType integrator, StepSettings settings,
         std::vector<BodyController> controllers = {});
 
-  /// Advances the simulation by settings().dt [s]. Stages: controllers drive their nodes; anchors set
-  /// their nodes' velocities toward their new poses; then per sub-step of dt / substeps: anchors move,
-  /// the integrator(s) step, planes push nodes out; last, the divergence guard checks every body.
+  /// Advances the simulation by settings().dt [s], as the named stages in world.cpp.
   void step();
 
   /// Simulated time [s] = number of steps taken * dt (no accumulated round-off); after setStepSettings,
@@ -51,20 +44,30 @@ public:
   double time() const { return time_origin_ + static_cast<double>(steps_ - steps_origin_) * settings_.dt; }
   std::int64_t stepCount() const { return steps_; }
 
+  /// What the scene is, with its live values: material scaling, gravity, drag and live pinning (attach,
+  /// the guard's freeze) are written into it; the scene's own values stay in MaterialScaling.
   const Model& model() const { return model_; }
   const State& state() const { return state_; }
   const StepSettings& settings() const { return settings_; }
   /// The scene's integrator (setIntegrator's); a body the guard switched may use another.
-  IntegratorType integrator() const { return integrator_type_; }
+  IntegratorType integrator() const { return integrators_.sceneType(); }
   /// The integrator stepping body `body` (index into model().bodies).
-  IntegratorType bodyIntegrator(std::size_t body) const { return body_integrator_.at(body); }
+  IntegratorType bodyIntegrator(std::size_t body) const { return integrators_.bodyType(body); }
   const std::vector<BodyController>& controllers() const { return controllers_; }
 
+  /// Calls `observer` after the integration of every sub-step, before contact (empty: none). For
+  /// measurements inside the step, such as how deep a node gets behind a plane before contact pushes it
+  /// out (the work-precision benchmark).
+  void observeIntegration(StateObserver observer) { integration_observer_ = std::move(observer); }
+
   /// Index of the anchor `anchor` of body `body` in model().anchors, or nullopt.
-  std::optional<int> findAnchor(const std::string& body, const std::string& anchor) const;
+  std::optional<int> findAnchor(const std::string& body, const std::string& anchor) const
+  {
+    return AnchorSet::find(model_, body, anchor);
+  }
   /// Moves the anchor's (pinned) node to `position` [m] during the next step, at constant velocity,
   /// so that springs and dashpots feel a smooth motion. The latest call before a step wins.
-  void moveAnchor(int anchor, const Vec3& position);
+  void moveAnchor(int anchor, const Vec3& position) { anchors_.setGoal(static_cast<std::size_t>(anchor), position); }
   /// Sets the target [m] of body `body` (creature, humanoid); false if it has none or is unknown.
   bool setTarget(const std::string& body, const Vec3& target);
 
@@ -76,7 +79,7 @@ public:
   /// std::invalid_argument on a bad value and keeps the old settings.
   void setStepSettings(const StepSettings& settings);
   /// Switches the integrator of every body; the new one starts from the current positions and velocities.
-  void setIntegrator(IntegratorType type);
+  void setIntegrator(IntegratorType type) { integrators_.setAll(type); }
   /// [m/s^2], finite; throws std::invalid_argument otherwise.
   void setGravity(const Vec3& gravity);
   /// Linear air drag [1/s], finite and >= 0; throws std::invalid_argument otherwise.
@@ -90,7 +93,7 @@ public:
   // --- anchors that follow a path, and grasping -----------------------------------------------------
   /// Every step, the anchor moves (as by moveAnchor) to path(t) at the step's end time t; an empty path
   /// stops following. A moveAnchor call before a step overrides the path for that step only.
-  void followPath(int anchor, AnchorPath path);
+  void followPath(int anchor, AnchorPath path) { anchors_.followPath(static_cast<std::size_t>(anchor), std::move(path)); }
   /// The free node of `body` (any body if empty) nearest to `point` [m] within `radius` [m], or nullopt.
   std::optional<int> nearestFreeNode(const Vec3& point, const std::string& body, double radius) const;
   /// Grasps free node `node`: pins it as a new anchor `name` of its body and returns the anchor's index
@@ -102,82 +105,54 @@ public:
   /// out of range.
   bool detach(int anchor);
   /// True for an anchor made by attach.
-  bool isAttached(int anchor) const;
+  bool isAttached(int anchor) const { return anchors_.isAttached(anchor); }
 
   /// Kinetic + potential energy [J] (see forces.h).
   double energy() const;
 
   // --- the divergence guard (guard.h) ---------------------------------------------------------------
   /// Throws std::invalid_argument if max_speed is not a finite number > 0.
-  void setGuard(const GuardSettings& guard);
-  const GuardSettings& guard() const { return guard_; }
+  void setGuard(const GuardSettings& guard) { guard_.setSettings(guard); }
+  const GuardSettings& guard() const { return guard_.settings(); }
   /// Catches since the world was made, over all bodies / of body `body` (index into model().bodies).
-  std::int64_t divergenceCount() const { return divergence_count_; }
-  std::int64_t divergenceCount(std::size_t body) const { return body_divergences_.at(body); }
+  std::int64_t divergenceCount() const { return guard_.count(); }
+  std::int64_t divergenceCount(std::size_t body) const { return guard_.count(body); }
   /// True once the guard froze body `body`.
-  bool isFrozen(std::size_t body) const { return frozen_.at(body) != 0; }
+  bool isFrozen(std::size_t body) const { return guard_.isFrozen(body); }
   /// The catches since the last call, oldest first, for the caller to log.
-  std::vector<DivergenceEvent> takeDivergenceEvents();
+  std::vector<DivergenceEvent> takeDivergenceEvents() { return guard_.takeEvents(); }
 
 private:
+  // The stages of step(), in their order.
   /// Controllers and anchors set their nodes for this step; true if any kinematic node moves.
   bool driveKinematicNodes(double dt);
-  /// Index into model().bodies of the body holding `node`.
-  std::size_t bodyOf(int node) const;
-  /// The integrators step one sub-step h: one for the whole model while every body uses the same,
-  /// else one per integrator over a copy of the model in which the other bodies' nodes are pinned.
-  void stepIntegrators(double h);
-  /// The model's parameters or pinning changed: integrators drop their caches, groups are rebuilt.
-  void modelChanged();
-  void invalidateIntegrators();
-  void rebuildGroups();
-  /// The guard stage: checks every body, restores and treats the diverged ones, keeps the good state.
+  /// Anchors move by one sub-step h [s].
+  void moveAnchors(double h);
+  void integrate(double h);
+  void resolveContacts(double h);
+  /// Anchors land on their goals.
+  void landAnchors();
+  /// Checks every body, restores and treats the diverged ones, keeps the good state.
   void guardBodies();
-  /// The guard's cheap check: true if body `body` is certainly fine (false says: look closer).
-  bool looksGood(const BodyRange& body) const;
-  /// Why body `body` counts as diverged now, or empty.
-  std::string divergence(const BodyRange& body) const;
-  /// Applies guard_.policy to body `body` and says what it did.
-  std::string treatDiverged(std::size_t body);
-  std::string freeze(std::size_t body);
 
-  /// Bodies stepped by one integrator type when bodies differ: the model with every other body's
-  /// nodes pinned (their positions and velocities belong to their own group, as an anchor's to us).
-  struct IntegratorGroup
-  {
-    IntegratorType type;
-    Model model;
-    std::unique_ptr<Integrator> integrator;
-  };
+  /// Applies the guard's policy to body `body` and says what it did.
+  std::string treatDiverged(std::size_t body);
+  /// The model's parameters or pinning changed: the integrators drop their caches.
+  void modelChanged() { integrators_.modelChanged(); }
 
   Model model_;
   State state_;
   StepSettings settings_;
-  IntegratorType integrator_type_;
-  std::unique_ptr<Integrator> integrator_;
   std::vector<BodyController> controllers_;
-  std::vector<std::optional<Vec3>> anchor_goals_;  ///< per anchor: where to be at the end of the next step
-  std::vector<AnchorPath> anchor_paths_;            ///< per anchor: followed every step if set
-  std::size_t scene_anchors_ = 0;                   ///< anchors [0, scene_anchors_) came with the scene
-  /// The material as built, which BodyScaling multiplies: per spring k and c, per constraint compliance,
-  /// per cell pressure, and the scaling of each body.
-  std::vector<Spring> built_springs_;
-  std::vector<DistanceConstraint> built_constraints_;
-  std::vector<PressureCell> built_cells_;
-  std::vector<BodyScaling> body_scaling_;
+  AnchorSet anchors_;
+  IntegratorGroups integrators_;
+  ContactStage contacts_;
+  MaterialScaling material_;
+  DivergenceGuard guard_;
+  StateObserver integration_observer_;
   double time_origin_ = 0.0;        ///< [s] simulated time at the last change of dt
   std::int64_t steps_origin_ = 0;   ///< step count then
-  std::vector<std::uint8_t> touching_;              ///< per node: on a plane after the last sub-step
   std::int64_t steps_ = 0;
-  std::vector<IntegratorType> body_integrator_;     ///< per body
-  std::vector<IntegratorGroup> groups_;             ///< empty while every body uses integrator_
-  bool groups_dirty_ = false;
-  GuardSettings guard_;
-  State last_good_;  ///< the state after the last step the guard saved (kGuardCheckpointSteps)
-  std::vector<std::uint8_t> frozen_;                ///< per body
-  std::vector<std::int64_t> body_divergences_;      ///< per body
-  std::int64_t divergence_count_ = 0;
-  std::vector<DivergenceEvent> events_;             ///< not yet taken
 };
 
 }  // namespace soft_body_sim

@@ -1,0 +1,40 @@
+// Live material: what each body was built with, and the factors a user turns on it while the scene runs
+// (the jelly seed's sliders "to make it more springy or viscous"). The factors multiply the built values,
+// so they never compound and 1 restores the scene.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+/// Live multipliers of one body's material, relative to the scene's values. 1 = as loaded; each > 0.
+struct BodyScaling
+{
+  double stiffness = 1.0;  ///< [-] spring stiffness k, and constraint stiffness 1 / compliance
+  double damping = 1.0;    ///< [-] spring dashpots c
+  double pressure = 1.0;   ///< [-] rest gas pressure p0 of the body's cells
+};
+
+class MaterialScaling
+{
+public:
+  /// Keeps `built`'s springs, constraints and cells as the values the factors multiply.
+  explicit MaterialScaling(const Model& built);
+
+  /// Writes body `body`'s springs, constraints and cells into `model` as built times `scaling`. Throws
+  /// std::invalid_argument if a factor is out of range (see BodyScaling) and changes nothing then.
+  void set(Model& model, std::size_t body, const BodyScaling& scaling);
+  /// The scaling last set for body `body` (all 1 if never set).
+  const BodyScaling& of(std::size_t body) const { return scaling_.at(body); }
+
+private:
+  std::vector<Spring> built_springs_;
+  std::vector<DistanceConstraint> built_constraints_;
+  std::vector<PressureCell> built_cells_;
+  std::vector<BodyScaling> scaling_;  ///< per body
+};
+
+}  // namespace soft_body_sim

@@ -1,0 +1,102 @@
+#include "soft_body_sim/core/integrator_groups.h"
+
+#include <algorithm>
+#include <iterator>
+
+namespace soft_body_sim
+{
+IntegratorGroups::IntegratorGroups(IntegratorType scene_type, std::size_t bodies)
+  : scene_type_(scene_type), integrator_(makeIntegrator(scene_type)), body_type_(bodies, scene_type)
+{
+}
+
+void IntegratorGroups::setAll(IntegratorType type)
+{
+  // Every integrator's state is (x, v) plus caches it rebuilds from them: a fresh one continues.
+  integrator_ = makeIntegrator(type);
+  scene_type_ = type;
+  std::fill(body_type_.begin(), body_type_.end(), type);
+  groups_.clear();
+  dirty_ = false;
+}
+
+void IntegratorGroups::switchBody(std::size_t body, IntegratorType type)
+{
+  body_type_.at(body) = type;
+  dirty_ = true;
+}
+
+void IntegratorGroups::prepare(const Model& model)
+{
+  if (dirty_)
+    rebuild(model);
+}
+
+void IntegratorGroups::step(const Model& model, State& state, double h, int iterations)
+{
+  if (groups_.empty())
+    integrator_->step(model, state, h, iterations);
+  for (Group& group : groups_)
+    group.integrator->step(group.model, state, h, iterations);
+}
+
+void IntegratorGroups::invalidate()
+{
+  integrator_->invalidate();
+  for (Group& group : groups_)
+    group.integrator->invalidate();
+}
+
+void IntegratorGroups::modelChanged()
+{
+  integrator_->modelChanged();
+  for (Group& group : groups_)
+    group.integrator->modelChanged();
+  if (!groups_.empty())
+    dirty_ = true;
+}
+
+void IntegratorGroups::rebuild(const Model& model)
+{
+  dirty_ = false;
+  groups_.clear();
+  // Each node goes with its body's integrator; a node of no body with the scene's.
+  std::vector<IntegratorType> node_type(static_cast<std::size_t>(model.nodeCount()), scene_type_);
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+  {
+    const BodyRange& body = model.bodies[b];
+    for (int i = body.first; i < body.first + body.count; ++i)
+      node_type[static_cast<std::size_t>(i)] = body_type_[b];
+  }
+  std::vector<IntegratorType> types;
+  for (const IntegratorType type : node_type)
+    if (std::find(types.begin(), types.end(), type) == types.end())
+      types.push_back(type);
+  if (types.size() == 1 && types.front() == scene_type_)
+    return;  // every node is on the scene's integrator: one model, no copies
+  for (const IntegratorType type : types)
+  {
+    const auto mine = [&](int node) { return node_type[static_cast<std::size_t>(node)] == type; };
+    Group group{ type, model, makeIntegrator(type) };
+    Model& m = group.model;
+    for (int i = 0; i < m.nodeCount(); ++i)
+      if (!mine(i))
+        m.inverse_mass[i] = 0.0;
+    // The elements that touch a node of the group (the others belong to other groups); no planes:
+    // contact is the world's stage, not the group's.
+    m.springs.clear();
+    std::copy_if(model.springs.begin(), model.springs.end(), std::back_inserter(m.springs),
+                 [&](const Spring& s) { return mine(s.a) || mine(s.b); });
+    m.constraints.clear();
+    std::copy_if(model.constraints.begin(), model.constraints.end(), std::back_inserter(m.constraints),
+                 [&](const DistanceConstraint& c) { return mine(c.a) || mine(c.b); });
+    m.cells.clear();
+    std::copy_if(model.cells.begin(), model.cells.end(), std::back_inserter(m.cells), [&](const PressureCell& c) {
+      return std::any_of(std::begin(c.nodes), std::end(c.nodes), mine);
+    });
+    m.planes.clear();
+    groups_.push_back(std::move(group));
+  }
+}
+
+}  // namespace soft_body_sim

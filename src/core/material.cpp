@@ -1,0 +1,39 @@
+#include "soft_body_sim/core/material.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace soft_body_sim
+{
+MaterialScaling::MaterialScaling(const Model& built)
+  : built_springs_(built.springs)
+  , built_constraints_(built.constraints)
+  , built_cells_(built.cells)
+  , scaling_(built.bodies.size())
+{
+}
+
+void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& scaling)
+{
+  // Stiffness and pressure divide (compliance = 1 / k, Boyle's law p0 A0 / A): they must stay > 0.
+  if (!(scaling.stiffness > 0.0 && std::isfinite(scaling.stiffness)) ||
+      !(scaling.pressure > 0.0 && std::isfinite(scaling.pressure)) ||
+      !(scaling.damping >= 0.0 && std::isfinite(scaling.damping)))
+    throw std::invalid_argument("World: body scaling: stiffness and pressure must be finite and > 0, damping >= 0");
+  scaling_.at(body) = scaling;
+  // From the built values, not the current ones: factors do not compound and 1 restores the scene.
+  for (std::size_t k = 0; k < model.springs.size(); ++k)
+    if (model.bodyOf(built_springs_[k].a) == body)
+    {
+      model.springs[k].stiffness = built_springs_[k].stiffness * scaling.stiffness;
+      model.springs[k].damping = built_springs_[k].damping * scaling.damping;
+    }
+  for (std::size_t k = 0; k < model.constraints.size(); ++k)
+    if (model.bodyOf(built_constraints_[k].a) == body)
+      model.constraints[k].compliance = built_constraints_[k].compliance / scaling.stiffness;
+  for (std::size_t k = 0; k < model.cells.size(); ++k)
+    if (model.bodyOf(built_cells_[k].nodes[0]) == body)
+      model.cells[k].pressure = built_cells_[k].pressure * scaling.pressure;
+}
+
+}  // namespace soft_body_sim
