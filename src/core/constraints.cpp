@@ -4,12 +4,6 @@
 
 namespace soft_body_sim
 {
-void solveDistance(const ConstraintRow& row, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-                   NodeArray& x, double& lambda)
-{
-  projectDistance(sweepRow(row, inverse_mass), inverse_mass, x_prev, x, lambda);
-}
-
 void projectConstraints(const Model& model, double h, int iterations, const NodeArray& x_prev, NodeArray& x,
                         Eigen::VectorXd& lambda)
 {

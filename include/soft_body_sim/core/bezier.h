@@ -25,28 +25,16 @@ inline Vec3 quadraticBezierTangent(const Vec3& p1, const Vec3& p2, const Vec3& p
   return (2.0 * (1.0 - t)) * (p2 - p1) + (2.0 * t) * (p3 - p2);
 }
 
-/// A curve sampled at equal parameter steps, with the (unnormalised) tangent dB/dt at each sample.
-struct SampledCurve
-{
-  std::vector<Vec3> points;    ///< [m]
-  std::vector<Vec3> tangents;  ///< dB/dt [m]
-};
-
-/// Samples the curve at t_i = i / (samples - 1), i = 0 .. samples - 1 (so both ends are included);
-/// `samples` below 2 is taken as 2.
-inline SampledCurve sampleQuadraticBezier(const Vec3& p1, const Vec3& p2, const Vec3& p3, int samples)
+/// The curve sampled at t_i = i / (samples - 1), i = 0 .. samples - 1 (so both ends are included) [m];
+/// `samples` below 2 is taken as 2. (Its tangents, where needed, are quadraticBezierTangent at the same t.)
+inline std::vector<Vec3> sampleQuadraticBezier(const Vec3& p1, const Vec3& p2, const Vec3& p3, int samples)
 {
   const int n = samples < 2 ? 2 : samples;
-  SampledCurve curve;
-  curve.points.reserve(static_cast<std::size_t>(n));
-  curve.tangents.reserve(static_cast<std::size_t>(n));
+  std::vector<Vec3> points;
+  points.reserve(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i)
-  {
-    const double t = static_cast<double>(i) / (n - 1);
-    curve.points.push_back(quadraticBezier(p1, p2, p3, t));
-    curve.tangents.push_back(quadraticBezierTangent(p1, p2, p3, t));
-  }
-  return curve;
+    points.push_back(quadraticBezier(p1, p2, p3, static_cast<double>(i) / (n - 1)));
+  return points;
 }
 
 }  // namespace soft_body_sim

@@ -5,7 +5,8 @@
 
 namespace soft_body_sim
 {
-/// One XPBD update of C = |x_a - x_b| - rest_length (Macklin, Mueller, Chentanez 2016, eqs. 18 and 26):
+/// One row of an XPBD update of C = |x_a - x_b| - rest_length (Macklin, Mueller, Chentanez 2016, eqs. 18
+/// and 26), solved by projectDistance (integrators/integrator_kit.h):
 ///   dlambda = (-C - alpha~ lambda - gamma gradC.(x - x_prev)) / ((1 + gamma)(w_a + w_b) + alpha~),
 ///   x_a += w_a dlambda u,  x_b -= w_b dlambda u,
 /// with alpha~ = compliance / h^2 and gamma = alpha~ beta h (beta [N s/m] the constraint's damping).
@@ -18,9 +19,6 @@ struct ConstraintRow
   double alpha_tilde;  ///< compliance / h^2 [1/kg]
   double gamma;        ///< alpha~ * damping * h [-]
 };
-
-void solveDistance(const ConstraintRow& row, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-                   NodeArray& x, double& lambda);
 
 /// Projects every DistanceConstraint of the model `iterations` times (Gauss-Seidel) for a (sub)step of h [s].
 /// `lambda` is scratch of size constraints.size().

@@ -76,8 +76,11 @@ struct Anchor
   int node = 0;  ///< global node index
 };
 
-/// Everything that stays fixed while a scene runs. Pinned node = inverse mass 0: no force moves it;
-/// only the caller (an anchor) does.
+/// What the scene is (topology and parameters), apart from where it is now (State). Its topology stays
+/// fixed while a scene runs; its parameters are the live ones: live tuning (gravity, drag, a body's
+/// material scaling) and live pinning (attach, detach, the guard's freeze) rewrite them, while the
+/// values the scene was built with stay in MaterialScaling. Pinned node = inverse mass 0: no force moves
+/// it; only the caller (an anchor) does.
 struct Model
 {
   Eigen::VectorXd mass;          ///< [kg] per node (kept for pinned nodes too, for reporting)

@@ -118,7 +118,7 @@ public:
       { at(kHumanoidLeftLeg), at(kHumanoidPelvis), at(kHumanoidRightLeg) },
     };
     for (const int root : kLimbRoots)
-      lines.push_back(limbCurve(state, first_node_ + root, def_.limbs.curve_samples).points);
+      lines.push_back(limbCurve(state, first_node_ + root, def_.limbs.curve_samples));
     return lines;
   }
 

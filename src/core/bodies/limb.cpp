@@ -59,7 +59,7 @@ public:
 
   std::vector<std::vector<Vec3>> curves(const State& state) const override
   {
-    return { limbCurve(state, first_node_, samples_).points };
+    return { limbCurve(state, first_node_, samples_) };
   }
 
 private:
@@ -106,7 +106,7 @@ void LimbDynamics::update(const Vec3& root)
   }
 }
 
-SampledCurve limbCurve(const State& state, int root_node, int samples)
+std::vector<Vec3> limbCurve(const State& state, int root_node, int samples)
 {
   return sampleQuadraticBezier(state.position.col(root_node + kLimbRoot), state.position.col(root_node + kLimbJoint),
                                state.position.col(root_node + kLimbLeaf), samples);

@@ -29,7 +29,7 @@ inline SweepRow sweepRow(const ConstraintRow& row, const Eigen::VectorXd& invers
   return SweepRow{ row.a, row.b, row.rest_length, row.alpha_tilde, row.gamma, inverse };
 }
 
-/// The body of solveDistance (constraints.h), inline for the integrators' sweeps. Its cost is bounded
+/// The XPBD update of one ConstraintRow (constraints.h), inline for the integrators' sweeps. Its cost is bounded
 /// by the divider, so it takes one square root and one division per update: u = d (1 / |d|) rather
 /// than three divisions, and the denominator's reciprocal from the row.
 [[gnu::always_inline]] inline void projectDistance(const SweepRow& row, const Eigen::VectorXd& inverse_mass,

@@ -82,7 +82,7 @@ private:
 
 /// The quadratic Bezier curve of the limb whose root is node `root_node` of `state` (joint and leaf
 /// follow it), sampled at `samples` points, with its tangents dB/dt.
-SampledCurve limbCurve(const State& state, int root_node, int samples);
+std::vector<Vec3> limbCurve(const State& state, int root_node, int samples);
 
 /// Checks a LimbMotion; throws std::invalid_argument naming `what` ("limb 'arm'").
 void checkLimbMotion(const LimbMotion& motion, const std::string& what);
