@@ -82,23 +82,9 @@ public:
   /// slope of that line, so attached springs feel a continuous motion.
   void step(double dt, State& state) override
   {
-    if (!started_)
-    {
-      update();
-      started_ = true;
-    }
-    for (std::int64_t due = clock_.advance(dt); due > 0; --due)
-    {
-      drawn_from_ = x_;
-      update();
-    }
-    const double phase = clock_.phase();
+    clock_.run(dt, [&] { drawn_from_ = x_; }, [&] { update(); });
     for (int i = 0; i < kPoints; ++i)
-    {
-      const Vec3 span = x_[i] - drawn_from_[i];
-      state.position.col(first_node_ + i) = drawn_from_[i] + phase * span;
-      state.velocity.col(first_node_ + i) = span / def_.update_period;
-    }
+      drawBetween(state, first_node_ + i, drawn_from_[i], x_[i], clock_.phase(), clock_.period());
   }
 
   /// A new target (projected into the swimming plane) steers the lead from the next update on. It starts
@@ -205,7 +191,6 @@ private:
   Points drawn_from_;  ///< the points at the last update instant passed [m]
   Vec3 target_;
   bool anticipate_ = false;
-  bool started_ = false;
 };
 
 /// Appends a tendril hanging from body point `side`: a rope from the side point along `direction`, whose

@@ -10,6 +10,8 @@
 #include <cstdint>
 #include <limits>
 
+#include "soft_body_sim/core/model.h"
+
 namespace soft_body_sim
 {
 /// Updates per physics step beyond which an animated body's time falls behind instead (the scene loader
@@ -42,6 +44,24 @@ public:
     return passed;
   }
 
+  /// Keeps a body's dynamics one update ahead of the world: the first call runs `update` once; then, for
+  /// every update instant that dt passes, `keep` saves the points of that instant (where the line they
+  /// are drawn on starts) and `update` computes the next update.
+  template <typename Keep, typename Update>
+  void run(double dt, Keep&& keep, Update&& update)
+  {
+    if (!started_)
+    {
+      update();
+      started_ = true;
+    }
+    for (std::int64_t due = advance(dt); due > 0; --due)
+    {
+      keep();
+      update();
+    }
+  }
+
   /// How far the body's time is into the current period, as a fraction in [0, 1).
   double phase() const { return std::clamp(elapsed_periods_ - static_cast<double>(reached_), 0.0, 1.0); }
 
@@ -52,6 +72,17 @@ private:
   double max_periods_per_step_;
   double elapsed_periods_ = 0.0;  ///< the body's time / T
   std::int64_t reached_ = 0;      ///< update instants n T passed so far
+  bool started_ = false;          ///< run() has computed the first update
 };
+
+/// Draws node `node` on the straight line from `from` (its point at the update instant passed) to `to`
+/// (at the next), at `phase` of the way, with the line's slope over `period` [s] as its velocity: at
+/// t = n T it is exactly at update n, and attached springs feel a continuous motion.
+inline void drawBetween(State& state, int node, const Vec3& from, const Vec3& to, double phase, double period)
+{
+  const Vec3 span = to - from;
+  state.position.col(node) = from + phase * span;
+  state.velocity.col(node) = span / period;
+}
 
 }  // namespace soft_body_sim

@@ -70,21 +70,17 @@ public:
   /// frames around it; the torso's nodes and the roots are the pelvis plus fixed offsets.
   void step(double dt, State& state) override
   {
-    if (!started_)
-    {
-      update();
-      started_ = true;
-    }
-    for (std::int64_t due = clock_.advance(dt); due > 0; --due)
-    {
-      pelvis_from_ = pelvis_;
-      for (std::size_t k = 0; k < limbs_.size(); ++k)
-      {
-        joint_from_[k] = limbs_[k]->joint();
-        leaf_from_[k] = limbs_[k]->leaf();
-      }
-      update();
-    }
+    clock_.run(
+        dt,
+        [&] {
+          pelvis_from_ = pelvis_;
+          for (std::size_t k = 0; k < limbs_.size(); ++k)
+          {
+            joint_from_[k] = limbs_[k]->joint();
+            leaf_from_[k] = limbs_[k]->leaf();
+          }
+        },
+        [&] { update(); });
     const double phase = clock_.phase();
     const double period = clock_.period();
     const Vec3 pelvis_velocity = (pelvis_ - pelvis_from_) / period;
@@ -95,10 +91,8 @@ public:
     {
       const int root = kLimbRoots[k];
       set(state, root + kLimbRoot, pelvis + frame_.offset[root], pelvis_velocity);
-      const Vec3 joint_span = limbs_[k]->joint() - joint_from_[k];
-      const Vec3 leaf_span = limbs_[k]->leaf() - leaf_from_[k];
-      set(state, root + kLimbJoint, joint_from_[k] + phase * joint_span, joint_span / period);
-      set(state, root + kLimbLeaf, leaf_from_[k] + phase * leaf_span, leaf_span / period);
+      drawBetween(state, first_node_ + root + kLimbJoint, joint_from_[k], limbs_[k]->joint(), phase, period);
+      drawBetween(state, first_node_ + root + kLimbLeaf, leaf_from_[k], limbs_[k]->leaf(), phase, period);
     }
   }
 
@@ -152,7 +146,6 @@ private:
   std::array<std::optional<LimbDynamics>, 4> limbs_;  ///< left arm, right arm, left leg, right leg
   std::array<Vec3, 4> joint_from_;
   std::array<Vec3, 4> leaf_from_;
-  bool started_ = false;
 };
 
 }  // namespace

@@ -38,23 +38,16 @@ public:
   void step(double dt, State& state) override
   {
     const Vec3 root = state.position.col(first_node_ + kLimbRoot);
-    if (!started_)
-    {
-      dynamics_.update(root);
-      started_ = true;
-    }
-    for (std::int64_t due = clock_.advance(dt); due > 0; --due)
-    {
-      joint_from_ = dynamics_.joint();
-      leaf_from_ = dynamics_.leaf();
-      dynamics_.update(root);
-    }
+    clock_.run(
+        dt,
+        [&] {
+          joint_from_ = dynamics_.joint();
+          leaf_from_ = dynamics_.leaf();
+        },
+        [&] { dynamics_.update(root); });
     const double phase = clock_.phase();
-    const double period = clock_.period();
-    state.position.col(first_node_ + kLimbJoint) = joint_from_ + phase * (dynamics_.joint() - joint_from_);
-    state.position.col(first_node_ + kLimbLeaf) = leaf_from_ + phase * (dynamics_.leaf() - leaf_from_);
-    state.velocity.col(first_node_ + kLimbJoint) = (dynamics_.joint() - joint_from_) / period;
-    state.velocity.col(first_node_ + kLimbLeaf) = (dynamics_.leaf() - leaf_from_) / period;
+    drawBetween(state, first_node_ + kLimbJoint, joint_from_, dynamics_.joint(), phase, clock_.period());
+    drawBetween(state, first_node_ + kLimbLeaf, leaf_from_, dynamics_.leaf(), phase, clock_.period());
   }
 
   std::vector<std::vector<Vec3>> curves(const State& state) const override
@@ -69,7 +62,6 @@ private:
   LimbDynamics dynamics_;
   Vec3 joint_from_;  ///< joint at the last update instant passed [m]
   Vec3 leaf_from_;
-  bool started_ = false;
 };
 
 }  // namespace
