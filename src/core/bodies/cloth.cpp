@@ -34,6 +34,36 @@ std::optional<int> gridCornerNode(const std::string& name, int columns, int rows
   return std::nullopt;
 }
 
+void addSpringGrid(BodyDef& body, const GridCorners& corners, int columns, int rows, double mass,
+                   const SpringParameters& edges, const SpringParameters& diagonals)
+{
+  const int first = static_cast<int>(body.nodes.size());
+  const double node_mass = mass / (columns * rows);
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < columns; ++i)
+      body.nodes.push_back(NodeDef{ corners.at(static_cast<double>(i) / (columns - 1), static_cast<double>(j) / (rows - 1)),
+                                    node_mass, Vec3::Zero(), false });
+  // Rest lengths stay empty: the flat initial layout is the rest shape.
+  const auto node = [first, columns](int i, int j) { return first + j * columns + i; };
+  const auto link = [&body](int a, int b, const SpringParameters& p) {
+    body.springs.push_back(SpringDef{ a, b, p.stiffness, p.damping, std::nullopt });
+  };
+  for (int j = 0; j < rows; ++j)
+    for (int i = 0; i < columns; ++i)
+    {
+      if (i + 1 < columns)
+        link(node(i, j), node(i + 1, j), edges);
+      if (j + 1 < rows)
+        link(node(i, j), node(i, j + 1), edges);
+    }
+  for (int j = 0; j + 1 < rows; ++j)
+    for (int i = 0; i + 1 < columns; ++i)
+    {
+      link(node(i, j), node(i + 1, j + 1), diagonals);
+      link(node(i + 1, j), node(i, j + 1), diagonals);
+    }
+}
+
 BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
 {
   if (cloth.nx < 2 || cloth.ny < 2 || !(cloth.mass > 0.0) || !(cloth.structural.stiffness > 0.0) ||
@@ -48,41 +78,20 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   body.type = "cloth";
   const int nx = cloth.nx;
   const int ny = cloth.ny;
-  const double node_mass = cloth.mass / (nx * ny);
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i)
-      body.nodes.push_back(NodeDef{ cloth.corners.at(static_cast<double>(i) / (nx - 1), static_cast<double>(j) / (ny - 1)),
-                                    node_mass, Vec3::Zero(), false });
+  addSpringGrid(body, cloth.corners, nx, ny, cloth.mass, cloth.structural, cloth.shear);
   for (int index : cloth.pinned)
     body.nodes[static_cast<std::size_t>(resolveNodeIndex(index, nx * ny))].pinned = true;
-
-  // Rest lengths stay empty: the flat initial layout is the rest shape.
   const auto node = [nx](int i, int j) { return j * nx + i; };
-  const auto link = [&body](int a, int b, const SpringParameters& p) {
-    body.springs.push_back(SpringDef{ a, b, p.stiffness, p.damping, std::nullopt });
-  };
-  for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i)
-    {
-      if (i + 1 < nx)
-        link(node(i, j), node(i + 1, j), cloth.structural);
-      if (j + 1 < ny)
-        link(node(i, j), node(i, j + 1), cloth.structural);
-    }
-  for (int j = 0; j + 1 < ny; ++j)
-    for (int i = 0; i + 1 < nx; ++i)
-    {
-      link(node(i, j), node(i + 1, j + 1), cloth.shear);
-      link(node(i + 1, j), node(i, j + 1), cloth.shear);
-    }
   if (cloth.bending.stiffness > 0.0)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)
       {
         if (i + 2 < nx)
-          link(node(i, j), node(i + 2, j), cloth.bending);
+          body.springs.push_back(SpringDef{ node(i, j), node(i + 2, j), cloth.bending.stiffness,
+                                            cloth.bending.damping, std::nullopt });
         if (j + 2 < ny)
-          link(node(i, j), node(i, j + 2), cloth.bending);
+          body.springs.push_back(SpringDef{ node(i, j), node(i, j + 2), cloth.bending.stiffness,
+                                            cloth.bending.damping, std::nullopt });
       }
   return body;
 }

@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "soft_body_sim/core/bodies/cloth.h"
+
 namespace soft_body_sim
 {
 BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
@@ -17,32 +19,14 @@ BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
   body.name = name;
   body.type = "jelly";
   const int columns = jelly.nx + 1;
-  const int rows = jelly.ny + 1;
-  const double node_mass = jelly.mass / (columns * rows);
-  for (int j = 0; j < rows; ++j)
-    for (int i = 0; i < columns; ++i)
-      body.nodes.push_back(NodeDef{ jelly.corners.at(static_cast<double>(i) / jelly.nx, static_cast<double>(j) / jelly.ny),
-                                    node_mass, Vec3::Zero(), false });
-
+  addSpringGrid(body, jelly.corners, columns, jelly.ny + 1, jelly.mass, jelly.edges, jelly.diagonals);
+  // One gas cell per square, its nodes right along the top edge, then down the left edge: counter-
+  // clockwise about top x left.
   const auto node = [columns](int i, int j) { return j * columns + i; };
-  const auto link = [&body](int a, int b, const SpringParameters& p) {
-    body.springs.push_back(SpringDef{ a, b, p.stiffness, p.damping, std::nullopt });
-  };
-  for (int j = 0; j < rows; ++j)
-    for (int i = 0; i < columns; ++i)
-    {
-      if (i + 1 < columns)
-        link(node(i, j), node(i + 1, j), jelly.edges);
-      if (j + 1 < rows)
-        link(node(i, j), node(i, j + 1), jelly.edges);
-    }
-  // Right along the top edge, then down the left edge: counter-clockwise about top x left.
   const Vec3 normal = jelly.corners.areaNormal().normalized();
   for (int j = 0; j < jelly.ny; ++j)
     for (int i = 0; i < jelly.nx; ++i)
     {
-      link(node(i, j), node(i + 1, j + 1), jelly.diagonals);
-      link(node(i + 1, j), node(i, j + 1), jelly.diagonals);
       CellDef cell;
       cell.nodes[0] = node(i, j);
       cell.nodes[1] = node(i + 1, j);

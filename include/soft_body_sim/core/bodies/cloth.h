@@ -57,6 +57,13 @@ struct ClothDef
   std::vector<int> pinned;                               ///< pinned node indices; negative counts from the end
 };
 
+/// Appends to `body` a grid of columns x rows nodes of equal mass (mass / (columns rows) [kg]) spanning
+/// `corners`, node (i, j) = j columns + i at corners.at(i / (columns - 1), j / (rows - 1)), then springs at
+/// rest between direct neighbours along rows and columns (`edges`), then across both diagonals of each
+/// square (`diagonals`). The cloth's and the jelly's common grid; columns and rows >= 2.
+void addSpringGrid(BodyDef& body, const GridCorners& corners, int columns, int rows, double mass,
+                   const SpringParameters& edges, const SpringParameters& diagonals);
+
 /// The cloth as nodes and springs (type "cloth"), every spring at rest in the flat initial layout;
 /// throws std::invalid_argument on a bad definition and std::out_of_range on a bad pinned index.
 BodyDef buildCloth(const std::string& name, const ClothDef& cloth);
