@@ -1,6 +1,7 @@
 #include "soft_body_sim/core/scene_def.h"
 
 #include <stdexcept>
+#include <string>
 
 #include "soft_body_sim/core/stability.h"
 
@@ -22,6 +23,15 @@ double restLengthOr(const std::optional<double>& rest_length, const State& state
   return rest_length ? *rest_length : (state.position.col(a) - state.position.col(b)).norm();
 }
 }  // namespace
+
+int resolveNodeIndex(long long index, int node_count)
+{
+  const long long resolved = index < 0 ? index + node_count : index;
+  if (resolved < 0 || resolved >= node_count)
+    throw std::out_of_range("node index " + std::to_string(index) + " out of range for " +
+                            std::to_string(node_count) + " nodes");
+  return static_cast<int>(resolved);
+}
 
 World buildWorld(const SceneDef& scene)
 {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/scene_def.h"
 #include "yaml_reader.h"
 
 namespace soft_body_sim
@@ -17,15 +19,26 @@ struct LimbMotion;
 
 namespace soft_body_sim::scene_yaml
 {
+/// A node index of a body of `node_count` nodes, a negative one counting from the end (-1 is the last
+/// node), made non-negative (resolveNodeIndex); one outside the body fails at the field.
+inline int readNodeIndex(const Context& ctx, const Field& field, int node_count)
+{
+  const long long index = readInteger(ctx, field);
+  const long long n = node_count;
+  if (index < -n || index >= n)
+    ctx.fail(field, "node index " + std::to_string(index) + " out of range; the body has " + std::to_string(n) +
+                        " nodes (" + std::to_string(-n) + ".." + std::to_string(n - 1) + ")");
+  return resolveNodeIndex(index, node_count);
+}
+
 /// The most nodes a scene may have, in all its bodies: a typo such as `nx: 100000` or
 /// `segments: 1e9` fails with a message rather than exhausting memory.
 constexpr long long kMaxSceneNodes = 1000000;
 
-/// The most updates a procedurally animated body may make per physics step, and the most relaxation
-/// passes per update. Both multiply the work of every step (the seeds make 1 to 4 updates of 1 to 8
-/// passes), so that a typo such as `update_period: 1e-9` or `iterations: 1000000` fails with a message
-/// rather than stalling the simulation.
-constexpr long long kMaxUpdatesPerStep = 100;
+/// The most relaxation passes per update of a procedurally animated body. With the most updates per
+/// physics step (kMaxUpdatesPerStep, controller.h) it multiplies the work of every step (the seeds make
+/// 1 to 4 updates of 1 to 8 passes), so that a typo such as `update_period: 1e-9` or
+/// `iterations: 1000000` fails with a message rather than stalling the simulation.
 constexpr long long kMaxRelaxationPasses = 100;
 
 /// `iterations` of a procedurally animated body: an integer in [1, kMaxRelaxationPasses].

@@ -110,13 +110,7 @@ void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
     for (const AnchorDef& other : body.anchors)
       if (other.name == anchor.name)
         ctx.fail(name, "duplicate anchor name " + quoted(anchor.name));
-    const Field node = requiredKey(ctx, item, "node");
-    const long long index = readInteger(ctx, node);
-    const long long n = static_cast<long long>(count);
-    if (index < -n || index >= n)
-      ctx.fail(node, "node index " + std::to_string(index) + " out of range; the body has " + std::to_string(count) +
-                         " nodes (" + std::to_string(-n) + ".." + std::to_string(n - 1) + ")");
-    anchor.node = static_cast<int>(index < 0 ? index + n : index);
+    anchor.node = readNodeIndex(ctx, requiredKey(ctx, item, "node"), static_cast<int>(count));
     if (const std::optional<Field> frame = optionalKey(item, "frame"))
     {
       anchor.frame = readNonEmptyString(ctx, *frame);

@@ -11,6 +11,11 @@
 
 namespace soft_body_sim
 {
+/// Updates per physics step beyond which an animated body's own time falls behind instead. The scene
+/// loader refuses a scene that asks for more when its dt is given; a `dt: auto` or live-tuned step may
+/// still ask for more, and an animated body's clock caps it here.
+constexpr int kMaxUpdatesPerStep = 100;
+
 class Controller
 {
 public:

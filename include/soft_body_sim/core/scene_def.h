@@ -98,6 +98,10 @@ struct SceneDef
   std::vector<BodyDef> bodies;
 };
 
+/// A node index of a body of `node_count` nodes made non-negative: a negative one counts from the end
+/// (-1 is the last node). Throws std::out_of_range if it is outside the body.
+int resolveNodeIndex(long long index, int node_count);
+
 /// Flattens the bodies into one node array (body k's nodes follow body k-1's), pins anchored nodes,
 /// makes the controllers and returns the world. Expects a valid scene (the loader checks); throws
 /// std::invalid_argument on an index out of range, a zero plane or cell normal, or a cell whose rest

@@ -10,15 +10,11 @@
 #include <cstdint>
 #include <limits>
 
+#include "soft_body_sim/core/controller.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
 {
-/// Updates per physics step beyond which an animated body's time falls behind instead (the scene loader
-/// refuses more when dt is given; a `dt: auto` or live-tuned step may still ask for more, and the cast
-/// below must never see an unbounded count).
-constexpr double kMaxPeriodsPerStep = 100.0;
-
 class FixedPeriodClock
 {
 public:
@@ -31,11 +27,11 @@ public:
   {
   }
 
-  /// Advances the body's time by min(dt, max_periods_per_step T, kMaxPeriodsPerStep T) and returns how many update instants
+  /// Advances the body's time by min(dt, max_periods_per_step T, kMaxUpdatesPerStep T) and returns how many update instants
   /// n T were passed (reached counts as passed).
   std::int64_t advance(double dt)
   {
-    elapsed_periods_ += std::min({ dt / period_, max_periods_per_step_, kMaxPeriodsPerStep });
+    elapsed_periods_ += std::min({ dt / period_, max_periods_per_step_, static_cast<double>(kMaxUpdatesPerStep) });
     // The sum of many dt / T lands a few ulps short of an exact multiple of T: 1e-9 period of slack
     // (33 ps at T = 1/30 s) makes t = n T count as reached whatever dt it was summed from.
     const auto reached = static_cast<std::int64_t>(std::floor(elapsed_periods_ + 1e-9));

@@ -4,15 +4,6 @@
 
 namespace soft_body_sim
 {
-int resolveNodeIndex(int index, int node_count)
-{
-  const int resolved = index < 0 ? index + node_count : index;
-  if (resolved < 0 || resolved >= node_count)
-    throw std::out_of_range("node index " + std::to_string(index) + " out of range for " +
-                            std::to_string(node_count) + " nodes");
-  return resolved;
-}
-
 BodyDef buildRope(const std::string& name, const RopeDef& rope)
 {
   if (rope.nodes < 2 || !(rope.mass > 0.0) || !(rope.stiffness > 0.0) || rope.damping < 0.0 ||

@@ -63,7 +63,6 @@ inline std::vector<int> readPinned(const Context& ctx, const Field& field, int n
                                    int rows = 0)
 {
   std::vector<int> pinned;
-  const long long n = node_count;
   for (const Field& item : requireList(ctx, field))
   {
     const bool named = rows > 0 && item.node.IsScalar() && !item.node.Scalar().empty() &&
@@ -79,11 +78,7 @@ inline std::vector<int> readPinned(const Context& ctx, const Field& field, int n
     }
     if (rows > 0 && !item.node.IsScalar())
       ctx.fail(item, "expected a node index or a corner name, got " + describe(item.node));
-    const long long index = readInteger(ctx, item);
-    if (index < -n || index >= n)
-      ctx.fail(item, "node index " + std::to_string(index) + " out of range; the body has " + std::to_string(n) +
-                         " nodes (" + std::to_string(-n) + ".." + std::to_string(n - 1) + ")");
-    pinned.push_back(static_cast<int>(index < 0 ? index + n : index));
+    pinned.push_back(readNodeIndex(ctx, item, node_count));
   }
   return pinned;
 }

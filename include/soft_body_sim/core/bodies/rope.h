@@ -25,7 +25,4 @@ struct RopeDef
 /// The rope as nodes and springs (type "rope"); throws std::invalid_argument on a bad definition.
 BodyDef buildRope(const std::string& name, const RopeDef& rope);
 
-/// A pinned index made non-negative: i < 0 counts from the end; throws std::out_of_range if outside.
-int resolveNodeIndex(int index, int node_count);
-
 }  // namespace soft_body_sim
