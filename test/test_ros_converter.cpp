@@ -151,5 +151,24 @@ TEST(RosConverter, PosesWithNaNOrInfinityAreRejected)
   EXPECT_EQ(position, Vec3(1.0, -2.0, 0.5));  // untouched by the rejected poses
 }
 
+TEST(RosConverter, APositionGoesIntoAPoseWithTheIdentityOrientationAndBack)
+{
+  const Vec3 p(1.5, -2.25, 0.125);
+  const geometry_msgs::Pose pose = RosConverter::toPose(p);
+  EXPECT_EQ(pose.position.x, 1.5);
+  EXPECT_EQ(pose.position.y, -2.25);
+  EXPECT_EQ(pose.position.z, 0.125);
+  EXPECT_EQ(pose.orientation.x, 0.0);
+  EXPECT_EQ(pose.orientation.y, 0.0);
+  EXPECT_EQ(pose.orientation.z, 0.0);
+  EXPECT_EQ(pose.orientation.w, 1.0);
+  EXPECT_EQ(RosConverter::toVec3(pose.position), p);
+  geometry_msgs::Vector3 translation;
+  translation.x = 3.0;
+  translation.y = 4.0;
+  translation.z = -5.0;
+  EXPECT_EQ(RosConverter::toVec3(translation), Vec3(3.0, 4.0, -5.0));
+}
+
 }  // namespace
 }  // namespace soft_body_sim::test

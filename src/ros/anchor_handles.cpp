@@ -5,6 +5,8 @@
 #include <geometry_msgs/PoseStamped.h>
 #include <visualization_msgs/InteractiveMarker.h>
 
+#include "soft_body_sim/ros/ros_converter.h"
+
 namespace soft_body_sim
 {
 namespace
@@ -42,10 +44,7 @@ void AnchorHandles::add(const std::string& name, const std::string& topic, const
   marker.name = name;
   marker.description = name;
   marker.scale = kHandleSize;
-  marker.pose.position.x = position.x();
-  marker.pose.position.y = position.y();
-  marker.pose.position.z = position.z();
-  marker.pose.orientation.w = 1.0;
+  marker.pose = RosConverter::toPose(position);
 
   // The grip: a sphere dragged in the view plane (MOVE_3D), plus an arrow per axis.
   visualization_msgs::InteractiveMarkerControl grip;
@@ -90,7 +89,7 @@ void AnchorHandles::onFeedback(const visualization_msgs::InteractiveMarkerFeedba
   pose.header.stamp = ros::Time::now();
   pose.pose = feedback->pose;
   it->second.publisher.publish(pose);
-  it->second.shown = Vec3(feedback->pose.position.x, feedback->pose.position.y, feedback->pose.position.z);
+  it->second.shown = RosConverter::toVec3(feedback->pose.position);
   it->second.dragged_until = ros::WallTime::now() + ros::WallDuration(kDragHold);
 }
 
@@ -101,12 +100,7 @@ void AnchorHandles::follow(const std::string& name, const Vec3& position)
   if (it == handles_.end() || ros::WallTime::now() < it->second.dragged_until ||
       (position - it->second.shown).norm() < kMoveThreshold || !position.allFinite())
     return;
-  geometry_msgs::Pose pose;
-  pose.position.x = position.x();
-  pose.position.y = position.y();
-  pose.position.z = position.z();
-  pose.orientation.w = 1.0;
-  server_.setPose(name, pose);
+  server_.setPose(name, RosConverter::toPose(position));
   it->second.shown = position;
   changed_ = true;
 }

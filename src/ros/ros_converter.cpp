@@ -142,9 +142,19 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
   return state;
 }
 
+geometry_msgs::Pose RosConverter::toPose(const Vec3& position)
+{
+  geometry_msgs::Pose pose;
+  pose.position.x = position.x();
+  pose.position.y = position.y();
+  pose.position.z = position.z();
+  pose.orientation.w = 1.0;
+  return pose;
+}
+
 bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why)
 {
-  const Vec3 p(pose.position.x, pose.position.y, pose.position.z);
+  const Vec3 p = toVec3(pose.position);
   const Eigen::Vector4d q(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w);
   if (!p.allFinite())
   {

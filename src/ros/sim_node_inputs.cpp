@@ -256,8 +256,7 @@ std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Ti
                       scene_.frame_id.c_str(), e.what());
     return std::nullopt;
   }
-  const geometry_msgs::Vector3& t = transform.transform.translation;
-  const Vec3 origin(t.x, t.y, t.z);
+  const Vec3 origin = RosConverter::toVec3(transform.transform.translation);
   if (!origin.allFinite())
     return std::nullopt;
   return origin;

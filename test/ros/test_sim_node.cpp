@@ -24,8 +24,9 @@
 #include <xmlrpcpp/XmlRpcClient.h>
 
 #include "soft_body_sim/SimState.h"
-#include "wait_for.h"
+#include "soft_body_sim/ros/ros_converter.h"
 #include "soft_body_sim/scene/scene_loader.h"
+#include "wait_for.h"
 
 namespace soft_body_sim
 {
@@ -38,14 +39,9 @@ geometry_msgs::PoseStamped pose(const std::string& frame, double x, double y, do
   geometry_msgs::PoseStamped p;
   p.header.frame_id = frame;
   p.header.stamp = ros::Time(0);
-  p.pose.position.x = x;
-  p.pose.position.y = y;
-  p.pose.position.z = z;
-  p.pose.orientation.w = 1.0;
+  p.pose = RosConverter::toPose(Vec3(x, y, z));
   return p;
 }
-
-Vec3 toVec3(const geometry_msgs::Point& p) { return Vec3(p.x, p.y, p.z); }
 
 /// The process id of the node publishing `topic`: the simulator's own, or the nodelet manager holding it
 /// (through the master's system state and the node's slave API, as rosnode info does). 0 if not found.
@@ -96,7 +92,7 @@ protected:
       state_ = *s;
       stamps_.push_back(s->header.stamp);
       factors_.push_back(s->real_time_factor);
-      start_path_.emplace_back(s->header.stamp, toVec3(s->bodies.at(0).positions.at(0)));
+      start_path_.emplace_back(s->header.stamp, RosConverter::toVec3(s->bodies.at(0).positions.at(0)));
       ++state_count_;
     });
     start_time_sub_ = nh_.subscribe<std_msgs::Time>("/soft_body_sim/start_time", 10,
@@ -143,7 +139,7 @@ protected:
     ASSERT_TRUE(ros::service::call("/soft_body_sim/reset", request));
   }
 
-  Vec3 node(int i) const { return toVec3(state_.bodies.at(0).positions.at(static_cast<std::size_t>(i))); }
+  Vec3 node(int i) const { return RosConverter::toVec3(state_.bodies.at(0).positions.at(static_cast<std::size_t>(i))); }
 
   /// Whether a warning logged since warnings_[from] holds every one of `parts`.
   bool warned(std::size_t from, const std::vector<std::string>& parts) const
@@ -232,7 +228,7 @@ TEST_F(SimNodeTest, MarkersAndStateArriveAtTheConfiguredRateWithMatchingPosition
   EXPECT_EQ(springs.points.size(), 8u);
   ASSERT_EQ(nodes.points.size(), 5u);
   for (int i = 0; i < 5; ++i)
-    EXPECT_EQ(toVec3(nodes.points[static_cast<std::size_t>(i)]), node(i)) << "node " << i;
+    EXPECT_EQ(RosConverter::toVec3(nodes.points[static_cast<std::size_t>(i)]), node(i)) << "node " << i;
 }
 
 TEST_F(SimNodeTest, AnAnchorPoseInAnotherFrameMovesTheNodeToTheTransformedPose)
@@ -322,11 +318,11 @@ TEST_F(SimNodeTest, NaNInfiniteUnknownAndHugeFramePosesAreDroppedAndNothingNonFi
   EXPECT_TRUE(waitFor([&] { return warned(from, { "/soft_body_sim/rope/start/pose", "1048576 characters" }); }, 10.0));
   for (const BodyState& body : state_.bodies)
     for (std::size_t i = 0; i < body.positions.size(); ++i)
-      EXPECT_TRUE(toVec3(body.positions[i]).allFinite() &&
+      EXPECT_TRUE(RosConverter::toVec3(body.positions[i]).allFinite() &&
                   Vec3(body.velocities[i].x, body.velocities[i].y, body.velocities[i].z).allFinite());
   for (const visualization_msgs::Marker& m : markers_.markers)
     for (const geometry_msgs::Point& p : m.points)
-      EXPECT_TRUE(toVec3(p).allFinite());
+      EXPECT_TRUE(RosConverter::toVec3(p).allFinite());
 }
 
 TEST_F(SimNodeTest, StaleAndFarFuturePosesAreDroppedWithAWarningNamingTheTopicOthersWaitForTheirStep)
@@ -428,7 +424,7 @@ TEST_F(SimNodeTest, APoseFloodAt10kHzKeepsMemoryBoundedTheLatestPoseWinsAndTheFa
   std::cout << "flood: resident memory " << before << " kB before, " << after << " kB after" << std::endl;
   for (const BodyState& body : state_.bodies)
     for (const geometry_msgs::Point& p : body.positions)
-      EXPECT_TRUE(toVec3(p).allFinite());
+      EXPECT_TRUE(RosConverter::toVec3(p).allFinite());
   EXPECT_LT(after - before, 2048);
 }
 

@@ -6,6 +6,7 @@
 #include <string>
 
 #include <geometry_msgs/Pose.h>
+#include <geometry_msgs/Vector3.h>
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -39,6 +40,13 @@ public:
 
   /// The position [m] of a pose; false (and why) if any field of the pose is NaN or infinite.
   static bool fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why);
+
+  /// A pose at `position` [m] with the identity orientation (anchors and handles have no orientation).
+  static geometry_msgs::Pose toPose(const Vec3& position);
+  /// The point of a message [m], as it is (not checked: see fromPose for inputs).
+  static Vec3 toVec3(const geometry_msgs::Point& point) { return Vec3(point.x, point.y, point.z); }
+  /// A translation [m], as it is.
+  static Vec3 toVec3(const geometry_msgs::Vector3& vector) { return Vec3(vector.x, vector.y, vector.z); }
 };
 
 }  // namespace soft_body_sim
