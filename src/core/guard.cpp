@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "soft_body_sim/core/names.h"
+
 namespace soft_body_sim
 {
 const std::vector<std::string>& guardPolicyNames()
@@ -19,14 +21,7 @@ std::string guardPolicyName(GuardPolicy policy) { return guardPolicyNames().at(s
 
 bool guardPolicyFromName(const std::string& name, GuardPolicy& policy)
 {
-  const std::vector<std::string>& names = guardPolicyNames();
-  for (std::size_t k = 0; k < names.size(); ++k)
-    if (names[k] == name)
-    {
-      policy = static_cast<GuardPolicy>(k);
-      return true;
-    }
-  return false;
+  return enumFromName(guardPolicyNames(), name, policy);
 }
 
 namespace

@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "integrators/integrator_kit.h"
+#include "soft_body_sim/core/names.h"
 
 namespace soft_body_sim
 {
@@ -15,6 +16,7 @@ struct Entry
   std::unique_ptr<Integrator> (*make)();
 };
 
+// In IntegratorType's order: integratorNames() lists them so, and enumFromName maps name k to value k.
 const Entry kEntries[] = {
   { IntegratorType::ExplicitEuler, "explicit_euler", makeExplicitEuler },
   { IntegratorType::SemiImplicitEuler, "semi_implicit_euler", makeSemiImplicitEuler },
@@ -38,15 +40,7 @@ std::string integratorName(IntegratorType type) { return entry(type).name; }
 
 bool integratorFromName(const std::string& name, IntegratorType& type)
 {
-  for (const Entry& e : kEntries)
-  {
-    if (name == e.name)
-    {
-      type = e.type;
-      return true;
-    }
-  }
-  return false;
+  return enumFromName(integratorNames(), name, type);
 }
 
 const std::vector<std::string>& integratorNames()
