@@ -1,5 +1,6 @@
 // The world's stages against independent truth: kinematic anchors and plane contacts.
 #include <cmath>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -151,6 +152,28 @@ TEST(Planes, PinnedNodesAreLeftWhereTheyAre)
   World world = buildWorld(scene);
   world.step();
   EXPECT_EQ(Vec3(world.state().position.col(0)), Vec3(0, 0, -1));
+}
+
+TEST(Strain, TheLargestRelativeStretchOfAnySpringOrConstraint)
+{
+  // Springs of rest 1 m at 1.5 m (strain 0.5) and 0.8 m (0.2), a constraint of rest 2 m at 2.2 m (0.1),
+  // a zero-rest-length spring (no strain defined: skipped).
+  Model model;
+  model.mass = Eigen::VectorXd::Ones(4);
+  model.inverse_mass = Eigen::VectorXd::Ones(4);
+  model.springs = { Spring{ 0, 1, 1.0, 10.0, 0.0 }, Spring{ 1, 2, 1.0, 10.0, 0.0 }, Spring{ 2, 3, 0.0, 10.0, 0.0 } };
+  model.constraints = { DistanceConstraint{ 0, 3, 2.0, 0.0 } };
+  State state;
+  state.position.resize(3, 4);
+  state.position << 0.0, 1.5, 2.3, 2.2,  //
+      0.0, 0.0, 0.0, 0.0,                 //
+      0.0, 0.0, 0.0, 0.0;
+  state.velocity = NodeArray::Zero(3, 4);
+  EXPECT_DOUBLE_EQ(maxStrain(model, state), 0.5);
+  model.springs[0].rest_length = 1.5;  // now at rest: the 0.8 m spring's 0.2 is the largest
+  EXPECT_NEAR(maxStrain(model, state), 0.2, 1e-15);
+  state.position(0, 2) = std::nan("");
+  EXPECT_EQ(maxStrain(model, state), std::numeric_limits<double>::infinity());
 }
 
 }  // namespace

@@ -1,6 +1,8 @@
 #include "soft_body_sim/core/forces.h"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Geometry>
 
@@ -103,6 +105,24 @@ double potentialEnergy(const Model& model, const State& state)
     if (model.isFree(i))
       energy -= model.mass[i] * model.gravity.dot(state.position.col(i));
   return energy;
+}
+
+double maxStrain(const Model& model, const State& state)
+{
+  const NodeArray& x = state.position;
+  double strain = 0.0;
+  const auto stretch = [&](int a, int b, double rest) {
+    if (!(rest > 0.0))
+      return;
+    const double s = std::abs((x.col(a) - x.col(b)).norm() - rest) / rest;
+    // A NaN would be dropped by std::max: a length that is not finite is an infinite strain.
+    strain = std::isnan(s) ? std::numeric_limits<double>::infinity() : std::max(strain, s);
+  };
+  for (const Spring& s : model.springs)
+    stretch(s.a, s.b, s.rest_length);
+  for (const DistanceConstraint& c : model.constraints)
+    stretch(c.a, c.b, c.rest_length);
+  return strain;
 }
 
 }  // namespace soft_body_sim

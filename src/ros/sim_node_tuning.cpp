@@ -1,11 +1,11 @@
 // SimNode's live tuning (dynamic_reconfigure: ~ for the physics, ~<body> for each body's material) and
 // its health on /diagnostics.
 #include <cmath>
-#include <limits>
 #include <sstream>
 
 #include <ros/names.h>
 
+#include "soft_body_sim/core/forces.h"
 #include "soft_body_sim/ros/sim_node.h"
 
 namespace soft_body_sim
@@ -104,18 +104,7 @@ std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& 
 
 void SimNode::watchDivergence()
 {
-  const Model& model = world_->model();
-  const NodeArray& x = world_->state().position;
-  double strain = 0.0;
-  const auto stretch = [&](int a, int b, double rest) {
-    if (rest > 0.0)
-      strain = std::max(strain, std::abs((x.col(a) - x.col(b)).norm() - rest) / rest);
-  };
-  for (const Spring& s : model.springs)
-    stretch(s.a, s.b, s.rest_length);
-  for (const DistanceConstraint& c : model.constraints)
-    stretch(c.a, c.b, c.rest_length);
-  max_strain_ = std::isfinite(strain) ? strain : std::numeric_limits<double>::infinity();
+  max_strain_ = maxStrain(world_->model(), world_->state());
   // Each catch once, as it happens: a body is caught at most eleven times (ten halvings, then frozen).
   for (const DivergenceEvent& event : world_->takeDivergenceEvents())
   {

@@ -74,4 +74,8 @@ double kineticEnergy(const Model& model, const State& state);
 /// of the free nodes.
 double potentialEnergy(const Model& model, const State& state);
 
+/// The largest strain |l - L| / L [-] of any spring or distance constraint with a rest length L > 0
+/// (l its length now); infinity if a length is not finite, 0 without any.
+double maxStrain(const Model& model, const State& state);
+
 }  // namespace soft_body_sim
