@@ -381,6 +381,7 @@ TEST(Creature, DrawsItsOutlineAndTakesTargets)
   EXPECT_EQ(curves[0][1], node(world, kCreatureLeftSide));
   EXPECT_TRUE(world.setTarget("creature", Vec3(1, 0, 0)));
   EXPECT_FALSE(world.setTarget("nobody", Vec3(1, 0, 0)));
+  EXPECT_TRUE(world.takesTarget(0));
 }
 
 // --- scene files --------------------------------------------------------------------------------

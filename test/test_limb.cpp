@@ -201,6 +201,7 @@ TEST(Limb, DrawsTheBezierCurveOfItsThreeNodes)
   for (int i = 0; i < 9; ++i)
     EXPECT_TRUE(expectNear(curves[0][static_cast<std::size_t>(i)], quadraticBezier(root, joint, leaf, i / 8.0), 1e-15));
   EXPECT_FALSE(world.setTarget("limb", Vec3::Zero())) << "a limb takes no target";
+  EXPECT_FALSE(world.takesTarget(0));
 }
 
 // --- humanoid -----------------------------------------------------------------------------------
@@ -254,6 +255,7 @@ TEST(Humanoid, TorsoReachesItsTarget)
   world.step();
   world.step();  // one frame; the target then applies from the next frame computed
   const Vec3 target = def.position + Vec3(0.6, -0.8, 0.0);
+  EXPECT_TRUE(world.takesTarget(0));
   world.setTarget("figure", target);
   const double r = def.torso_retention;
   const double kt2 = def.torso_stiffness * t * t;

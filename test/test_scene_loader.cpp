@@ -1002,6 +1002,10 @@ bodies:
   EXPECT_EQ(world.model().inverse_mass[0], 0.0);
   EXPECT_EQ(world.model().inverse_mass[1], 1.0);
   EXPECT_EQ(world.model().inverse_mass[2], 0.0);
+  // The world's anchors say which tf frame each follows (the ROS node asks the world).
+  ASSERT_EQ(world.model().anchors.size(), 2u);
+  EXPECT_EQ(world.model().anchors[0].frame, "");
+  EXPECT_EQ(world.model().anchors[1].frame, "gripper_link");
   EXPECT_EQ(world.model().planes[0].normal, Vec3(0, 0, 1));
 }
 

@@ -99,7 +99,7 @@ World buildWorld(const SceneDef& scene)
     {
       const int node = globalIndex(body, first, anchor.node);
       model.inverse_mass[node] = 0.0;
-      model.anchors.push_back({ body.name, anchor.name, node });
+      model.anchors.push_back({ body.name, anchor.name, node, anchor.frame });
     }
     if (body.controller)
       controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });

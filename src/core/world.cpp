@@ -123,6 +123,14 @@ std::string World::treatDiverged(std::size_t body)
   return freeze();
 }
 
+bool World::takesTarget(std::size_t body) const
+{
+  for (const BodyController& c : controllers_)
+    if (static_cast<std::size_t>(c.body) == body)
+      return c.controller->takesTarget();
+  return false;
+}
+
 bool World::setTarget(const std::string& body, const Vec3& target)
 {
   for (BodyController& c : controllers_)
@@ -215,7 +223,7 @@ int World::attach(int node, const std::string& name)
     throw std::invalid_argument("World: body '" + body + "' already has an anchor '" + name + "'");
   // Pinned = inverse mass 0: from now on only the anchor moves it (Ten Minute Physics' grab).
   model_.inverse_mass[node] = 0.0;
-  model_.anchors.push_back({ body, name, node });
+  model_.anchors.push_back({ body, name, node, "" });
   anchors_.added();
   modelChanged();
   return static_cast<int>(model_.anchors.size()) - 1;

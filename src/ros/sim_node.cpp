@@ -73,10 +73,10 @@ void SimNode::buildWorldFromScene()
   for (const auto& [body, server] : body_reconfigure_)
     applyBodyConfig(body, server->config());
   max_steps_per_tick_ = std::max(1L, std::lround(std::ceil(2.0 / (rate_ * world_->settings().dt))));
-  for (const BodyDef& body : scene_.bodies)
-    for (const AnchorDef& anchor : body.anchors)
-      if (!anchor.frame.empty())
-        followFrame(*world_->findAnchor(body.name, anchor.name), anchor.frame);
+  const std::vector<Anchor>& anchors = world_->model().anchors;
+  for (std::size_t k = 0; k < anchors.size(); ++k)
+    if (!anchors[k].frame.empty())
+      followFrame(static_cast<int>(k), anchors[k].frame);
   targets_.clear();
   inputs_.clear();
 }

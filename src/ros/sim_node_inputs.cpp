@@ -95,12 +95,13 @@ void SimNode::subscribeInputs()
             schedule(topic, pose->header.stamp, input);
         }));
   }
-  for (const BodyDef& body : scene_.bodies)
+  const Model& model = world_->model();
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
   {
-    if (body.type != "creature" && body.type != "humanoid")
+    if (!world_->takesTarget(b))
       continue;
-    const std::string topic = private_nh_.resolveName(body.name + "/target");
-    const std::string name = body.name;
+    const std::string name = model.bodies[b].name;
+    const std::string topic = private_nh_.resolveName(name + "/target");
     subscribers_.push_back(private_nh_.subscribe<geometry_msgs::PoseStamped>(
         topic, kInputQueueSize, [this, topic, name](const geometry_msgs::PoseStamped::ConstPtr& pose) {
           ScheduledInput input;
@@ -117,25 +118,23 @@ void SimNode::addHandles()
   handles_ = std::make_unique<AnchorHandles>(private_nh_.resolveName("handles"), scene_.frame_id);
   const Model& model = world_->model();
   handle_names_.assign(model.anchors.size(), "");
-  for (const BodyDef& body : scene_.bodies)
-    for (const AnchorDef& def : body.anchors)
-    {
-      if (!def.frame.empty())
-        continue;  // it follows its tf frame
-      const int k = *world_->findAnchor(body.name, def.name);
-      const std::string name = body.name + "/" + def.name;
-      handle_names_[static_cast<std::size_t>(k)] = name;
-      handles_->add(name, private_nh_.resolveName(name + "/pose"), world_->state().position.col(model.anchors[k].node));
-    }
-  for (std::size_t b = 0; b < scene_.bodies.size(); ++b)
+  for (std::size_t k = 0; k < model.anchors.size(); ++k)
   {
-    const BodyDef& body = scene_.bodies[b];
-    if (body.type != "creature" && body.type != "humanoid")
+    const Anchor& anchor = model.anchors[k];
+    if (!anchor.frame.empty())
+      continue;  // it follows its tf frame
+    const std::string name = anchor.body + "/" + anchor.name;
+    handle_names_[k] = name;
+    handles_->add(name, private_nh_.resolveName(name + "/pose"), world_->state().position.col(anchor.node));
+  }
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+  {
+    if (!world_->takesTarget(b))
       continue;
     // Until a target is set, the handle waits at the body's first node (lead, pelvis).
-    const std::string name = body.name + "/target";
+    const std::string name = model.bodies[b].name + "/target";
     handles_->add(name, private_nh_.resolveName(name), world_->state().position.col(model.bodies[b].first));
-    target_handles_.emplace_back(body.name, name);
+    target_handles_.emplace_back(model.bodies[b].name, name);
   }
   handles_->applyChanges();
 }

@@ -23,6 +23,8 @@ public:
   /// Advances the procedural motion by dt [s] and writes the positions [m] and velocities [m/s] of its
   /// nodes into `state`; it may read any node (e.g. a root following a torso).
   virtual void step(double dt, State& state) = 0;
+  /// True if the body moves toward a target (setTarget).
+  virtual bool takesTarget() const { return false; }
   /// Sets the point [m] the body moves toward; returns false if this body takes no target.
   virtual bool setTarget(const Vec3& target)
   {

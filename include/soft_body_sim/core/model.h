@@ -73,7 +73,8 @@ struct Anchor
 {
   std::string body;
   std::string name;
-  int node = 0;  ///< global node index
+  int node = 0;       ///< global node index
+  std::string frame;  ///< a tf frame whose origin the ROS node makes it follow; empty = its pose topic
 };
 
 /// What the scene is (topology and parameters), apart from where it is now (State). Its topology stays

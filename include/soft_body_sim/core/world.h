@@ -70,6 +70,8 @@ public:
   void moveAnchor(int anchor, const Vec3& position) { anchors_.setGoal(static_cast<std::size_t>(anchor), position); }
   /// Sets the target [m] of body `body` (creature, humanoid); false if it has none or is unknown.
   bool setTarget(const std::string& body, const Vec3& target);
+  /// True if body `body` (index into model().bodies) takes a target.
+  bool takesTarget(std::size_t body) const;
 
   /// Sets a node's position [m] and velocity [m/s] directly.
   void setNode(int node, const Vec3& position, const Vec3& velocity);

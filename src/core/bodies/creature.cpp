@@ -87,6 +87,8 @@ public:
       drawBetween(state, first_node_ + i, drawn_from_[i], x_[i], clock_.phase(), clock_.period());
   }
 
+  bool takesTarget() const override { return true; }
+
   /// A new target (projected into the swimming plane) steers the lead from the next update on. It starts
   /// a move with anticipation only if the lead had settled on the previous target and the new one lies
   /// farther than the settle distance from it (creature.h: streamed targets); the same target again does

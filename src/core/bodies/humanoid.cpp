@@ -96,6 +96,8 @@ public:
     }
   }
 
+  bool takesTarget() const override { return true; }
+
   bool setTarget(const Vec3& target) override
   {
     target_ = target;
