@@ -3,10 +3,12 @@
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "soft_body_sim/core/scene_def.h"
+#include "soft_body_sim/core/stability.h"
 
 namespace soft_body_sim::test
 {
@@ -24,6 +26,22 @@ template <typename A, typename B>
   Eigen::IOFormat format(Eigen::FullPrecision, 0, ", ", "; ", "", "", "[", "]");
   return ::testing::AssertionFailure() << "\n  actual:   " << a.format(format) << "\n  expected: " << b.format(format)
                                        << "\n  max |difference| " << error << " > tolerance " << tol;
+}
+
+/// The integrators whose stability limits (stability.h) `scene`'s step keeps, in integratorNames() order:
+/// the ones the scene may use.
+inline std::vector<IntegratorType> stableIntegrators(const SceneDef& scene)
+{
+  std::vector<IntegratorType> stable;
+  for (const std::string& name : integratorNames())
+  {
+    SceneDef with = scene;
+    integratorFromName(name, with.physics.integrator);
+    const World world = buildWorld(with);
+    if (stabilityWarnings(world.model(), world.state(), with.physics.integrator, world.settings()).empty())
+      stable.push_back(with.physics.integrator);
+  }
+  return stable;
 }
 
 inline bool allFinite(const State& state)
