@@ -93,7 +93,7 @@ TEST(ClothBuilder, StructuralShearAndOnlyRequestedBendingSprings)
     }
     EXPECT_EQ(strains(world, 100.0).size(), static_cast<std::size_t>(structural));
   }
-  cloth.bending = { 5.0, 0.0 };
+  cloth.bending = SpringParameters{ 5.0, 0.0 };
   scene.bodies[0] = buildCloth("c", cloth);
   const World world = buildWorld(scene);
   const int bending = (5 - 2) * 4 + 5 * (4 - 2);

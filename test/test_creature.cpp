@@ -514,13 +514,13 @@ TEST(CreatureScene, BadValuesAreRejectedWithOneLineAtTheKey)
   expectSceneError(creatureWith("lead_retention: 1.5"), at + "lead_retention", { "[0, 1]" });
   expectSceneError(creatureWith("anticipation: -0.2"), at + "anticipation", { ">= 0" });
   expectSceneError(creatureWith("settle_tolerance: 0"), at + "settle_tolerance", { "> 0" });
-  expectSceneError(creatureWith("parallel_retention: -0.1"), at + "parallel_retention", { ">= 0" });
+  expectSceneError(creatureWith("parallel_retention: -0.1"), at + "parallel_retention", { "[0, 1]", "-0.1" });
   expectSceneError(creatureWith("perpendicular_retention: 2"), at + "perpendicular_retention", { "[0, 1]" });
   expectSceneError(creatureWith("side_retention: 1.01"), at + "side_retention", { "[0, 1]" });
-  expectSceneError(creatureWith("min_ratio: 0"), at + "min_ratio", { "> 0" });
+  expectSceneError(creatureWith("min_ratio: 0"), at + "min_ratio", { "(0, 1]", "got 0" });
   expectSceneError(creatureWith("min_ratio: 1.2"), at + "min_ratio", { "(0, 1]" });
   expectSceneError(creatureWith("max_ratio: 0.9"), at + "max_ratio", { ">= 1" });
-  expectSceneError(creatureWith("soft_strength: 0"), at + "soft_strength", { "> 0" });
+  expectSceneError(creatureWith("soft_strength: 0"), at + "soft_strength", { "(0, 1]", "got 0" });
   expectSceneError(creatureWith("hard_strength: 1.5"), at + "hard_strength", { "(0, 1]" });
   expectSceneError(creatureWith("iterations: 0"), at + "iterations", { "[1," });
   expectSceneError(creatureWith("tendrils: {segments: 0}"), at + "tendrils.segments", { "[1," });

@@ -426,7 +426,7 @@ BodyDef smallCloth(const Vec3& offset)
   cloth.mass = 0.2;
   cloth.structural = { 500.0, 0.05 };
   cloth.shear = { 100.0, 0.02 };
-  cloth.bending = { 20.0, 0.0 };
+  cloth.bending = SpringParameters{ 20.0, 0.0 };
   cloth.pinned = { 0, 4 };
   return buildCloth("cloth", cloth);
 }

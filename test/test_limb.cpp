@@ -428,11 +428,11 @@ TEST(LimbScene, BadValuesAreRejectedWithOneLineAtTheKey)
     SCOPED_TRACE(type);
     expectSceneError(bodyWith(type, "gravity: [0, 0]"), at + "gravity", { "3 numbers" });
     expectSceneError(bodyWith(type, "frame_period: 0"), at + "frame_period", { "> 0" });
-    expectSceneError(bodyWith(type, "max_frames_per_step: -4"), at + "max_frames_per_step", { "> 0" });
+    expectSceneError(bodyWith(type, "max_frames_per_step: -4"), at + "max_frames_per_step", { "(0, 100]", "-4" });
     expectSceneError(bodyWith(type, "iterations: 0"), at + "iterations", { "[1," });
     expectSceneError(bodyWith(type, "iterations: 2.5"), at + "iterations", { "integer" });
     expectSceneError(bodyWith(type, "tension: 1"), at + "tension", { "(0, 1)" });
-    expectSceneError(bodyWith(type, "tension: 0"), at + "tension", { "> 0" });
+    expectSceneError(bodyWith(type, "tension: 0"), at + "tension", { "(0, 1)", "got 0" });
     expectSceneError(bodyWith(type, "retention: 1.2"), at + "retention", { "[0, 1]" });
     expectSceneError(bodyWith(type, "curve_samples: 1"), at + "curve_samples", { "[2," });
     expectSceneError(bodyWith(type, "elbow: 3"), at + "elbow", { "unknown key", "curve_samples" });
@@ -457,8 +457,8 @@ TEST(HumanoidScene, BadValuesAreRejectedWithOneLineAtTheKey)
   // k T^2 = 1e5 / 3600 = 28 > 2 (1 + 0.9)
   expectSceneError(bodyWith("humanoid", "torso_stiffness: 100000"), at + "torso_stiffness", { "stable" });
   expectSceneError(bodyWith("humanoid", "torso_retention: 2"), at + "torso_retention", { "[0, 1]" });
-  // Parallel up and facing through `up` alone: reported at the body (line 2), from the core's check.
-  expectSceneError(bodyWith("humanoid", "up: [1, 0, 0]"), "bad.yaml:2: bodies[0]", { "not parallel" });
+  // Parallel up and facing through `up` alone (facing keeps its default): reported at `up`.
+  expectSceneError(bodyWith("humanoid", "up: [1, 0, 0]"), at + "up", { "parallel to up" });
 }
 
 }  // namespace

@@ -1,7 +1,8 @@
 // The readers of each body type. A reader gets a body mapping whose `type` it owns, checks the keys
-// (its own plus the common ones: name, type, anchors) and returns the body expanded into nodes,
-// springs and constraints (plus a controller for procedural bodies). The loader then fills in the
-// name and type and reads the anchors, whose node indices refer to the expanded body.
+// (its own plus the common ones: name, type, anchors), parses their values into the type's definition
+// and hands it to the type's builder (buildBody), which checks it and expands it into nodes, springs and
+// constraints (plus a controller for procedural bodies). The loader then reads the anchors, whose node
+// indices refer to the expanded body.
 #pragma once
 
 #include <stdexcept>
@@ -31,26 +32,6 @@ inline int readNodeIndex(const Context& ctx, const Field& field, int node_count)
   return resolveNodeIndex(index, node_count);
 }
 
-/// The most nodes a scene may have, in all its bodies: a typo such as `nx: 100000` or
-/// `segments: 1e9` fails with a message rather than exhausting memory.
-constexpr long long kMaxSceneNodes = 1000000;
-
-/// The most relaxation passes per update of a procedurally animated body. With the most updates per
-/// physics step (kMaxUpdatesPerStep, controller.h) it multiplies the work of every step (the seeds make
-/// 1 to 4 updates of 1 to 8 passes), so that a typo such as `update_period: 1e-9` or
-/// `iterations: 1000000` fails with a message rather than stalling the simulation.
-constexpr long long kMaxRelaxationPasses = 100;
-
-/// `iterations` of a procedurally animated body: an integer in [1, kMaxRelaxationPasses].
-inline int readRelaxationPasses(const Context& ctx, const Field& field)
-{
-  const long long passes = readInteger(ctx, field);
-  if (passes < 1 || passes > kMaxRelaxationPasses)
-    ctx.fail(field, "must be an integer in [1, " + std::to_string(kMaxRelaxationPasses) + "], got " +
-                        field.node.Scalar());
-  return static_cast<int>(passes);
-}
-
 /// What a body's reader needs of the scene read before the body: the physics (read first) and the
 /// nodes of the bodies before it.
 struct SceneSoFar
@@ -70,16 +51,25 @@ struct SceneSoFar
   }
 };
 
-/// The last stage of a procedural body's reader: `build(name, def)` (buildCreature, buildLimb, ...) with
-/// the body's name, which its own checks quote. A std::invalid_argument from a check the reader did not
-/// make is still one line at the body.
+/// The field an error about `keys` points at: the first of them that `map` sets (a dotted key such as
+/// "tendrils.mass" looks into nested mappings), else `map` itself.
+Field firstPresent(const Field& map, const std::vector<std::string>& keys);
+
+/// The last stage of every generated body's reader: `build(name, def)` (buildRope, buildCreature, ...)
+/// with the body's `name`. The builder checks the definition; its DefinitionError becomes one line at the
+/// first of the keys it names that the file sets (any other std::invalid_argument: at the body).
 template <typename Def, typename Build>
-BodyDef buildProceduralBody(const Context& ctx, const Field& field, const Def& def, Build build)
+BodyDef buildBody(const Context& ctx, const Field& field, const Def& def, Build build)
 {
   const std::string name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
   try
   {
     return build(name, def);
+  }
+  catch (const DefinitionError& e)
+  {
+    const Field at = firstPresent(field, e.keys());
+    ctx.fail(at, e.what() + (at.node.IsScalar() ? ", got " + at.node.Scalar() : std::string()));
   }
   catch (const std::invalid_argument& e)
   {

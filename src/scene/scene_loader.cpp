@@ -134,8 +134,6 @@ BodyDef readBody(const Context& ctx, const Field& field, const SceneSoFar& scene
     if (name == body_type.name)
     {
       BodyDef body = body_type.read(ctx, field, scene);
-      body.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
-      body.type = name;
       if (const std::optional<Field> anchors = optionalKey(field, "anchors"))
         readAnchors(ctx, *anchors, body);
       return body;

@@ -279,6 +279,14 @@ long long readInteger(const Context& ctx, const Field& field)
   return value;
 }
 
+int readInt(const Context& ctx, const Field& field)
+{
+  const long long value = readInteger(ctx, field);
+  if (value < INT_MIN || value > INT_MAX)
+    ctx.fail(field, "integer out of range: " + quoted(field.node.Scalar()));
+  return static_cast<int>(value);
+}
+
 int readAtLeastOne(const Context& ctx, const Field& field)
 {
   const long long value = readInteger(ctx, field);

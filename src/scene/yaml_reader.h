@@ -83,6 +83,8 @@ double readPositive(const Context& ctx, const Field& field);
 double readNonNegative(const Context& ctx, const Field& field);
 /// A plain decimal integer ([-+]?[0-9]+).
 long long readInteger(const Context& ctx, const Field& field);
+/// An integer in [INT_MIN, INT_MAX].
+int readInt(const Context& ctx, const Field& field);
 /// An integer in [1, INT_MAX].
 int readAtLeastOne(const Context& ctx, const Field& field);
 /// YAML 1.2 booleans only (true/True/TRUE, false/False/FALSE).

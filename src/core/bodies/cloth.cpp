@@ -34,6 +34,19 @@ std::optional<int> gridCornerNode(const std::string& name, int columns, int rows
   return std::nullopt;
 }
 
+void requireGrid(const std::string& what, const GridCorners& corners, double mass)
+{
+  requireDefinition(corners.spansParallelogram(), what, { "bottom_left", "top_right", "top_left" },
+                    "top_left, top_right and bottom_left must span a parallelogram; they are collinear or coincide");
+  requireDefinition(mass > 0.0, what, { "mass" }, "mass must be > 0");
+}
+
+void requireSprings(const std::string& what, const std::string& key, const SpringParameters& springs)
+{
+  requireDefinition(springs.stiffness > 0.0, what, { key + ".stiffness", key }, key + ".stiffness must be > 0");
+  requireDefinition(springs.damping >= 0.0, what, { key + ".damping", key }, key + ".damping must be >= 0");
+}
+
 void addSpringGrid(BodyDef& body, const GridCorners& corners, int columns, int rows, double mass,
                    const SpringParameters& edges, const SpringParameters& diagonals)
 {
@@ -66,13 +79,13 @@ void addSpringGrid(BodyDef& body, const GridCorners& corners, int columns, int r
 
 BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
 {
-  if (cloth.nx < 2 || cloth.ny < 2 || !(cloth.mass > 0.0) || !(cloth.structural.stiffness > 0.0) ||
-      !(cloth.shear.stiffness > 0.0) || cloth.bending.stiffness < 0.0 || cloth.structural.damping < 0.0 ||
-      cloth.shear.damping < 0.0 || cloth.bending.damping < 0.0)
-    throw std::invalid_argument("cloth '" + name + "': needs nx, ny >= 2, mass > 0, structural and shear "
-                                "stiffness > 0, no negative bending stiffness or damping");
-  if (!cloth.corners.spansParallelogram())
-    throw std::invalid_argument("cloth '" + name + "': the corners span no parallelogram");
+  const std::string what = "cloth '" + name + "'";
+  requireDefinition(cloth.nx >= 2 && cloth.ny >= 2, what, { "nx", "ny" }, "nx and ny must be >= 2");
+  requireGrid(what, cloth.corners, cloth.mass);
+  requireSprings(what, "structural", cloth.structural);
+  requireSprings(what, "shear", cloth.shear);
+  if (cloth.bending)
+    requireSprings(what, "bending", *cloth.bending);
   BodyDef body;
   body.name = name;
   body.type = "cloth";
@@ -82,16 +95,16 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   for (int index : cloth.pinned)
     body.nodes[static_cast<std::size_t>(resolveNodeIndex(index, nx * ny))].pinned = true;
   const auto node = [nx](int i, int j) { return j * nx + i; };
-  if (cloth.bending.stiffness > 0.0)
+  if (cloth.bending)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)
       {
         if (i + 2 < nx)
-          body.springs.push_back(SpringDef{ node(i, j), node(i + 2, j), cloth.bending.stiffness,
-                                            cloth.bending.damping, std::nullopt });
+          body.springs.push_back(SpringDef{ node(i, j), node(i + 2, j), cloth.bending->stiffness,
+                                            cloth.bending->damping, std::nullopt });
         if (j + 2 < ny)
-          body.springs.push_back(SpringDef{ node(i, j), node(i, j + 2), cloth.bending.stiffness,
-                                            cloth.bending.damping, std::nullopt });
+          body.springs.push_back(SpringDef{ node(i, j), node(i, j + 2), cloth.bending->stiffness,
+                                            cloth.bending->damping, std::nullopt });
       }
   return body;
 }

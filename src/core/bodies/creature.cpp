@@ -29,12 +29,6 @@ namespace
 constexpr int kPoints = kCreatureBodyPoints;
 using Points = std::array<Vec3, kPoints>;
 
-void check(bool ok, const std::string& name, const std::string& what)
-{
-  if (!ok)
-    throw std::invalid_argument("creature '" + name + "': " + what);
-}
-
 bool isFraction(double value) { return value >= 0.0 && value <= 1.0; }
 
 /// The start layout: the lead at `position`, the orientation point one spine length behind it, the side
@@ -221,34 +215,49 @@ void addTendril(BodyDef& body, int side, const TendrilDef& tendril)
 
 BodyDef buildCreature(const std::string& name, const CreatureDef& def)
 {
-  check(def.length > 0.0 && def.width > 0.0, name, "length and width must be > 0");
-  check(def.update_period > 0.0, name, "update_period must be > 0");
-  check(def.stiffness >= 0.0, name, "stiffness must be >= 0");
-  check(isFraction(def.lead_retention) && isFraction(def.parallel_retention) &&
-            isFraction(def.perpendicular_retention) && isFraction(def.side_retention),
-        name, "retentions must be in [0, 1]");
+  const std::string what = "creature '" + name + "'";
+  const auto check = [&what](bool ok, std::vector<std::string> keys, const std::string& reason) {
+    requireDefinition(ok, what, std::move(keys), reason);
+  };
+  check(def.length > 0.0, { "length" }, "length must be > 0");
+  check(def.width > 0.0, { "width" }, "width must be > 0");
+  check(def.update_period > 0.0, { "update_period" }, "update_period must be > 0");
+  check(def.stiffness >= 0.0, { "stiffness" }, "stiffness must be >= 0");
+  for (const auto& [key, value] : { std::pair{ "lead_retention", def.lead_retention },
+                                    std::pair{ "parallel_retention", def.parallel_retention },
+                                    std::pair{ "perpendicular_retention", def.perpendicular_retention },
+                                    std::pair{ "side_retention", def.side_retention } })
+    check(isFraction(value), { key }, std::string(key) + " must be in [0, 1]");
   // The lead's recurrence z^2 - (1 + r - k T^2) z + r = 0 has both roots inside the unit circle iff
   // r < 1 and 0 < k T^2 < 2 (1 + r) (Jury's test); k = 0 or r = 1 is marginal (no spring / no drag).
-  check(def.stiffness * def.update_period * def.update_period < 2.0 * (1.0 + def.lead_retention), name,
-        "stiffness * update_period^2 must be < 2 (1 + lead_retention) for a stable lead");
-  check(def.anticipation >= 0.0, name, "anticipation must be >= 0");
-  check(def.settle_tolerance > 0.0, name, "settle_tolerance must be > 0");
-  check(def.iterations >= 1, name, "iterations must be >= 1");
-  check(def.min_ratio > 0.0 && def.min_ratio <= 1.0 && def.max_ratio >= 1.0, name,
-        "min_ratio must be in (0, 1] and max_ratio >= 1");
-  check(def.soft_strength > 0.0 && def.soft_strength <= 1.0 && def.hard_strength > 0.0 && def.hard_strength <= 1.0,
-        name, "soft_strength and hard_strength must be in (0, 1]");
-  check(def.plane_normal.norm() > 1e-12, name, "plane_normal must not be zero");
+  const double k_t2 = def.stiffness * def.update_period * def.update_period;
+  check(k_t2 < 2.0 * (1.0 + def.lead_retention), { "stiffness", "update_period", "lead_retention" },
+        "stiffness * update_period^2 = " + std::to_string(k_t2) + " must be < 2 (1 + lead_retention) = " +
+            std::to_string(2.0 * (1.0 + def.lead_retention)) + " for the lead's recurrence to be stable");
+  check(def.anticipation >= 0.0, { "anticipation" }, "anticipation must be >= 0");
+  check(def.settle_tolerance > 0.0, { "settle_tolerance" }, "settle_tolerance must be > 0");
+  check(def.iterations >= 1 && def.iterations <= kMaxRelaxationPasses, { "iterations" },
+        "iterations must be in [1, " + std::to_string(kMaxRelaxationPasses) + "]");
+  check(def.min_ratio > 0.0 && def.min_ratio <= 1.0, { "min_ratio" }, "min_ratio must be in (0, 1]");
+  check(def.max_ratio >= 1.0, { "max_ratio" }, "max_ratio must be >= 1");
+  check(def.soft_strength > 0.0 && def.soft_strength <= 1.0, { "soft_strength" }, "soft_strength must be in (0, 1]");
+  check(def.hard_strength > 0.0 && def.hard_strength <= 1.0, { "hard_strength" }, "hard_strength must be in (0, 1]");
+  check(def.plane_normal.norm() > 1e-12, { "plane_normal" }, "plane_normal must not be zero");
+  check(def.heading.norm() > 1e-12, { "heading" }, "heading must not be zero");
   const Vec3 normal = def.plane_normal.normalized();
-  check((def.heading - normal * normal.dot(def.heading)).norm() > 1e-9 * def.heading.norm() &&
-            def.heading.norm() > 1e-12,
-        name, "heading must not be zero or parallel to plane_normal");
+  check((def.heading - normal * normal.dot(def.heading)).norm() > 1e-9 * def.heading.norm(),
+        { "heading", "plane_normal" },
+        "heading must not be parallel to plane_normal (the spine lies in the swimming plane)");
   if (def.tendrils)
   {
     const TendrilDef& t = *def.tendrils;
-    check(t.segments >= 1 && t.length > 0.0 && t.mass > 0.0 && t.stiffness > 0.0 && t.damping >= 0.0, name,
-          "tendrils need segments >= 1, length, mass and stiffness > 0, damping >= 0");
-    check(t.direction.norm() > 1e-12, name, "tendrils.direction must not be zero");
+    check(t.segments >= 1 && t.segments <= kMaxSceneNodes / 2, { "tendrils.segments" },  // two tendrils
+          "tendrils.segments must be in [1, " + std::to_string(kMaxSceneNodes / 2) + "]");
+    for (const auto& [key, value] : { std::pair{ "length", t.length }, std::pair{ "mass", t.mass },
+                                      std::pair{ "stiffness", t.stiffness } })
+      check(value > 0.0, { std::string("tendrils.") + key }, std::string("tendrils.") + key + " must be > 0");
+    check(t.damping >= 0.0, { "tendrils.damping" }, "tendrils.damping must be >= 0");
+    check(t.direction.norm() > 1e-12, { "tendrils.direction" }, "tendrils.direction must not be zero");
   }
 
   BodyDef body;

@@ -155,22 +155,28 @@ private:
 BodyDef buildHumanoid(const std::string& name, const HumanoidDef& def)
 {
   const std::string what = "humanoid '" + name + "'";
-  const auto check = [&](bool ok, const char* message) {
-    if (!ok)
-      throw std::invalid_argument(what + ": " + message);
+  const auto check = [&what](bool ok, std::vector<std::string> keys, const std::string& reason) {
+    requireDefinition(ok, what, std::move(keys), reason);
   };
   checkLimbMotion(def.limbs, what);
-  check(def.torso_length > 0.0 && def.head_height > 0.0 && def.shoulder_width > 0.0 && def.hip_width > 0.0 &&
-            def.arm_length > 0.0 && def.leg_length > 0.0,
-        "torso_length, head_height, shoulder_width, hip_width, arm_length and leg_length must be > 0");
-  check(def.torso_stiffness >= 0.0, "torso_stiffness must be >= 0");
-  check(def.torso_retention >= 0.0 && def.torso_retention <= 1.0, "torso_retention must be in [0, 1]");
+  for (const auto& [key, value] : { std::pair{ "torso_length", def.torso_length },
+                                    std::pair{ "head_height", def.head_height },
+                                    std::pair{ "shoulder_width", def.shoulder_width },
+                                    std::pair{ "hip_width", def.hip_width }, std::pair{ "arm_length", def.arm_length },
+                                    std::pair{ "leg_length", def.leg_length } })
+    check(value > 0.0, { key }, std::string(key) + " must be > 0");
+  check(def.torso_stiffness >= 0.0, { "torso_stiffness" }, "torso_stiffness must be >= 0");
+  check(def.torso_retention >= 0.0 && def.torso_retention <= 1.0, { "torso_retention" },
+        "torso_retention must be in [0, 1]");
   // The pelvis's recurrence is the creature lead's: stable for k T^2 < 2 (1 + r).
-  check(def.torso_stiffness * def.limbs.frame_period * def.limbs.frame_period < 2.0 * (1.0 + def.torso_retention),
-        "torso_stiffness * frame_period^2 must be < 2 (1 + torso_retention) for a stable torso");
-  check(def.up.norm() > 1e-12 && def.facing.norm() > 1e-12 &&
-            def.up.normalized().cross(def.facing.normalized()).norm() > 1e-9,
-        "up and facing must be non-zero and not parallel");
+  const double k_t2 = def.torso_stiffness * def.limbs.frame_period * def.limbs.frame_period;
+  check(k_t2 < 2.0 * (1.0 + def.torso_retention), { "torso_stiffness", "frame_period", "torso_retention" },
+        "torso_stiffness * frame_period^2 = " + std::to_string(k_t2) + " must be < 2 (1 + torso_retention) = " +
+            std::to_string(2.0 * (1.0 + def.torso_retention)) + " for the torso's recurrence to be stable");
+  check(def.up.norm() > 1e-12, { "up" }, "up must not be zero");
+  check(def.facing.norm() > 1e-12, { "facing" }, "facing must not be zero");
+  check(def.up.normalized().cross(def.facing.normalized()).norm() > 1e-9, { "facing", "up" },
+        "facing must not be parallel to up");
 
   const TorsoFrame frame = torsoFrame(def);
   BodyDef body;

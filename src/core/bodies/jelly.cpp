@@ -8,13 +8,12 @@ namespace soft_body_sim
 {
 BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
 {
-  if (jelly.nx < 1 || jelly.ny < 1 || !(jelly.mass > 0.0) || !(jelly.edges.stiffness > 0.0) ||
-      !(jelly.diagonals.stiffness > 0.0) || jelly.edges.damping < 0.0 || jelly.diagonals.damping < 0.0 ||
-      !(jelly.pressure > 0.0))
-    throw std::invalid_argument("jelly '" + name + "': needs nx, ny >= 1, mass > 0, edge and diagonal "
-                                "stiffness > 0, no negative damping, pressure > 0");
-  if (!jelly.corners.spansParallelogram())
-    throw std::invalid_argument("jelly '" + name + "': the corners span no parallelogram");
+  const std::string what = "jelly '" + name + "'";
+  requireDefinition(jelly.nx >= 1 && jelly.ny >= 1, what, { "nx", "ny" }, "nx and ny must be >= 1");
+  requireGrid(what, jelly.corners, jelly.mass);
+  requireSprings(what, "edges", jelly.edges);
+  requireSprings(what, "diagonals", jelly.diagonals);
+  requireDefinition(jelly.pressure > 0.0, what, { "pressure" }, "pressure must be > 0");
   BodyDef body;
   body.name = name;
   body.type = "jelly";

@@ -106,29 +106,32 @@ std::vector<Vec3> limbCurve(const State& state, int root_node, int samples)
 
 void checkLimbMotion(const LimbMotion& motion, const std::string& what)
 {
-  const auto check = [&](bool ok, const char* message) {
-    if (!ok)
-      throw std::invalid_argument(what + ": " + message);
+  const auto check = [&what](bool ok, const char* key, const std::string& reason) {
+    requireDefinition(ok, what, { key }, key + (" " + reason));
   };
-  check(motion.gravity.allFinite(), "gravity must be finite");
-  check(motion.frame_period > 0.0, "frame_period must be > 0");
-  check(motion.max_frames_per_step > 0.0, "max_frames_per_step must be > 0");
-  check(motion.iterations >= 1, "iterations must be >= 1");
+  check(motion.gravity.allFinite(), "gravity", "must be finite");
+  check(motion.frame_period > 0.0, "frame_period", "must be > 0");
+  check(motion.max_frames_per_step > 0.0 && motion.max_frames_per_step <= kMaxUpdatesPerStep, "max_frames_per_step",
+        "must be in (0, " + std::to_string(kMaxUpdatesPerStep) + "]");
+  check(motion.iterations >= 1 && motion.iterations <= kMaxRelaxationPasses, "iterations",
+        "must be in [1, " + std::to_string(kMaxRelaxationPasses) + "]");
   // A link between two free ends changes its error by the factor 1 - 2 tension per pass: it converges
   // for 0 < tension < 1 (at 1 it flips sign forever).
-  check(motion.tension > 0.0 && motion.tension < 1.0, "tension must be in (0, 1)");
-  check(motion.retention >= 0.0 && motion.retention <= 1.0, "retention must be in [0, 1]");
-  check(motion.curve_samples >= 2, "curve_samples must be >= 2");
+  check(motion.tension > 0.0 && motion.tension < 1.0, "tension",
+        "must be in (0, 1) (a free link's error changes by 1 - 2 tension per pass)");
+  check(motion.retention >= 0.0 && motion.retention <= 1.0, "retention", "must be in [0, 1]");
+  // Every published marker carries the curve: a few dozen points draw it smoothly.
+  check(motion.curve_samples >= 2 && motion.curve_samples <= kMaxCurveSamples, "curve_samples",
+        "must be in [2, " + std::to_string(kMaxCurveSamples) + "]");
 }
 
 BodyDef buildLimb(const std::string& name, const LimbDef& def)
 {
   const std::string what = "limb '" + name + "'";
   checkLimbMotion(def.motion, what);
-  if (!(def.upper_length > 0.0 && def.lower_length > 0.0))
-    throw std::invalid_argument(what + ": upper_length and lower_length must be > 0");
-  if (!(def.direction.norm() > 1e-12))
-    throw std::invalid_argument(what + ": direction must not be zero");
+  requireDefinition(def.upper_length > 0.0, what, { "upper_length" }, "upper_length must be > 0");
+  requireDefinition(def.lower_length > 0.0, what, { "lower_length" }, "lower_length must be > 0");
+  requireDefinition(def.direction.norm() > 1e-12, what, { "direction" }, "direction must not be zero");
   const Vec3 along = def.direction.normalized();
   const Vec3 joint = def.root + def.upper_length * along;
   const Vec3 leaf = joint + def.lower_length * along;

@@ -6,12 +6,17 @@ namespace soft_body_sim
 {
 BodyDef buildRope(const std::string& name, const RopeDef& rope)
 {
-  if (rope.nodes < 2 || !(rope.mass > 0.0) || !(rope.stiffness > 0.0) || rope.damping < 0.0 ||
-      rope.bending < 0.0 || rope.bending_damping < 0.0)
-    throw std::invalid_argument("rope '" + name + "': needs >= 2 nodes, mass > 0, stiffness > 0, no negative "
-                                "damping or bending");
-  if (!((rope.to - rope.from).norm() > 0.0))
-    throw std::invalid_argument("rope '" + name + "': from and to must differ");
+  const std::string what = "rope '" + name + "'";
+  requireDefinition(rope.nodes >= 2, what, { "nodes" }, "nodes must be >= 2");
+  requireDefinition(rope.mass > 0.0, what, { "mass" }, "mass must be > 0");
+  requireDefinition(rope.stiffness > 0.0, what, { "stiffness" }, "stiffness must be > 0");
+  requireDefinition(rope.damping >= 0.0, what, { "damping" }, "damping must be >= 0");
+  requireDefinition(rope.bending >= 0.0, what, { "bending" }, "bending must be >= 0");
+  requireDefinition(rope.bending_damping >= 0.0, what, { "bending_damping" }, "bending_damping must be >= 0");
+  requireDefinition(rope.bending_damping == 0.0 || rope.bending > 0.0, what, { "bending_damping" },
+                    "bending_damping has no effect without bending > 0 (there are no bending springs to damp)");
+  requireDefinition((rope.to - rope.from).norm() > 0.0, what, { "to", "from" },
+                    "to must differ from 'from'; a rope needs a length");
   BodyDef body;
   body.name = name;
   body.type = "rope";

@@ -14,15 +14,14 @@ BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& 
   checkGridSize(ctx, ny, cloth.nx, cloth.ny);
   scene.requireNodes(ctx, ny, static_cast<long long>(cloth.nx) * cloth.ny);
   cloth.corners = readGridCorners(ctx, field);
-  cloth.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
+  cloth.mass = readNumber(ctx, requiredKey(ctx, field, "mass"));
   cloth.structural = readSpringParameters(ctx, requiredKey(ctx, field, "structural"));
   cloth.shear = readSpringParameters(ctx, requiredKey(ctx, field, "shear"));
-  cloth.bending = SpringParameters{ 0.0, 0.0 };
   if (const std::optional<Field> value = optionalKey(field, "bending"))
     cloth.bending = readSpringParameters(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "pinned"))
     cloth.pinned = readPinned(ctx, *value, cloth.nx * cloth.ny, cloth.nx, cloth.ny);
-  return buildCloth("cloth", cloth);
+  return buildBody(ctx, field, cloth, buildCloth);
 }
 
 }  // namespace soft_body_sim::scene_yaml

@@ -62,7 +62,8 @@ ConstraintDef readConstraint(const Context& ctx, const Field& field, std::size_t
 BodyDef readCustomBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nodes", "springs", "constraints" }));
-  BodyDef body;
+  BodyDef body;  // a custom body is its own definition: BodyDef's type is "custom"
+  body.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
   const Field nodes = requiredKey(ctx, field, "nodes");
   const std::vector<Field> items = requireList(ctx, nodes);
   scene.requireNodes(ctx, nodes, static_cast<long long>(items.size()));

@@ -31,14 +31,14 @@ inline void checkGridSize(const Context& ctx, const Field& field, long long colu
                         " nodes, more than " + std::to_string(kMaxGeneratedNodes));
 }
 
-/// `{stiffness: k, damping: c}`: k [N/m] > 0 required, c [N s/m] >= 0 (default 0).
+/// `{stiffness: k, damping: c}`: k [N/m] required, c [N s/m] (default 0); requireSprings checks them.
 inline SpringParameters readSpringParameters(const Context& ctx, const Field& field)
 {
   requireMap(ctx, field, { "stiffness", "damping" });
   SpringParameters spring;
-  spring.stiffness = readPositive(ctx, requiredKey(ctx, field, "stiffness"));
+  spring.stiffness = readNumber(ctx, requiredKey(ctx, field, "stiffness"));
   if (const std::optional<Field> value = optionalKey(field, "damping"))
-    spring.damping = readNonNegative(ctx, *value);
+    spring.damping = readNumber(ctx, *value);
   return spring;
 }
 
@@ -48,11 +48,7 @@ inline GridCorners readGridCorners(const Context& ctx, const Field& body)
   GridCorners corners;
   corners.top_left = readVec3(ctx, requiredKey(ctx, body, "top_left"));
   corners.top_right = readVec3(ctx, requiredKey(ctx, body, "top_right"));
-  const Field bottom_left = requiredKey(ctx, body, "bottom_left");
-  corners.bottom_left = readVec3(ctx, bottom_left);
-  if (!corners.spansParallelogram())
-    ctx.fail(bottom_left, "top_left, top_right and bottom_left must span a parallelogram; they are collinear "
-                          "or coincide");
+  corners.bottom_left = readVec3(ctx, requiredKey(ctx, body, "bottom_left"));
   return corners;
 }
 

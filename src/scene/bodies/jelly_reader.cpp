@@ -15,11 +15,11 @@ BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& 
   checkGridSize(ctx, ny, jelly.nx + 1LL, jelly.ny + 1LL);
   scene.requireNodes(ctx, ny, (jelly.nx + 1LL) * (jelly.ny + 1LL));
   jelly.corners = readGridCorners(ctx, field);
-  jelly.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
+  jelly.mass = readNumber(ctx, requiredKey(ctx, field, "mass"));
   jelly.edges = readSpringParameters(ctx, requiredKey(ctx, field, "edges"));
   jelly.diagonals = readSpringParameters(ctx, requiredKey(ctx, field, "diagonals"));
-  jelly.pressure = readPositive(ctx, requiredKey(ctx, field, "pressure"));
-  return buildJelly("jelly", jelly);
+  jelly.pressure = readNumber(ctx, requiredKey(ctx, field, "pressure"));
+  return buildBody(ctx, field, jelly, buildJelly);
 }
 
 }  // namespace soft_body_sim::scene_yaml

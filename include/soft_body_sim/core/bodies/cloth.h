@@ -53,7 +53,7 @@ struct ClothDef
   double mass = 0.2;                                     ///< total mass [kg], spread equally over the nodes
   SpringParameters structural{ 200.0, 0.05 };            ///< springs to the 4 direct neighbours
   SpringParameters shear{ 50.0, 0.05 };                  ///< springs across each square's 2 diagonals
-  SpringParameters bending{ 0.0, 0.0 };                  ///< springs to second neighbours; stiffness 0 = none
+  std::optional<SpringParameters> bending;               ///< springs to second neighbours; none by default
   std::vector<int> pinned;                               ///< pinned node indices; negative counts from the end
 };
 
@@ -61,6 +61,12 @@ struct ClothDef
 /// `corners`, node (i, j) = j columns + i at corners.at(i / (columns - 1), j / (rows - 1)), then springs at
 /// rest between direct neighbours along rows and columns (`edges`), then across both diagonals of each
 /// square (`diagonals`). The cloth's and the jelly's common grid; columns and rows >= 2.
+/// The checks of a grid body (cloth, jelly) named `what`: corners that span a parallelogram and a total
+/// mass > 0 (DefinitionError otherwise).
+void requireGrid(const std::string& what, const GridCorners& corners, double mass);
+/// The checks of a spring family `key` of a grid body: stiffness > 0, damping >= 0.
+void requireSprings(const std::string& what, const std::string& key, const SpringParameters& springs);
+
 void addSpringGrid(BodyDef& body, const GridCorners& corners, int columns, int rows, double mass,
                    const SpringParameters& edges, const SpringParameters& diagonals);
 

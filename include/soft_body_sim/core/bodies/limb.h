@@ -23,6 +23,9 @@
 namespace soft_body_sim
 {
 /// How a limb moves; shared by `limb` and the four limbs of `humanoid`.
+/// The most points of a drawn limb curve (LimbMotion::curve_samples).
+constexpr int kMaxCurveSamples = 10000;
+
 struct LimbMotion
 {
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  ///< [m/s^2] on joint and leaf (pinned nodes: physics.gravity does
