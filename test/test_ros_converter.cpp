@@ -1,9 +1,10 @@
-// Message conversions as plain structs (no ROS master): markers, state and poses.
+// Message conversions as plain structs (no ROS master): markers, state, poses and reconfigure configs.
 #include <cmath>
 #include <limits>
 
 #include <gtest/gtest.h>
 
+#include "soft_body_sim/core/bodies/humanoid.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/ros/ros_converter.h"
 #include "test_util.h"
@@ -168,6 +169,75 @@ TEST(RosConverter, APositionGoesIntoAPoseWithTheIdentityOrientationAndBack)
   translation.y = 4.0;
   translation.z = -5.0;
   EXPECT_EQ(RosConverter::toVec3(translation), Vec3(3.0, 4.0, -5.0));
+}
+
+TEST(RosConverter, TheLivePhysicsGoIntoTheReconfigureConfigAndBack)
+{
+  World world = twoBodies();
+  world.setIntegrator(IntegratorType::Xpbd);
+  world.setStepSettings(StepSettings{ 0.004, 3, 7 });
+  world.setGravity(Vec3(0.5, -1.0, -9.0));
+  world.setDrag(0.25);
+  const SimConfig config = RosConverter::toSimConfig(world);
+  EXPECT_EQ(config.integrator, "xpbd");
+  EXPECT_EQ(config.dt, 0.004);
+  EXPECT_EQ(config.substeps, 3);
+  EXPECT_EQ(config.iterations, 7);
+  EXPECT_EQ(config.drag, 0.25);
+  EXPECT_EQ(RosConverter::gravityOf(config), Vec3(0.5, -1.0, -9.0));
+  const StepSettings step = RosConverter::stepSettingsOf(config);
+  EXPECT_EQ(step.dt, 0.004);
+  EXPECT_EQ(step.substeps, 3);
+  EXPECT_EQ(step.iterations, 7);
+  IntegratorType integrator = IntegratorType::Rk4;
+  std::string why;
+  ASSERT_TRUE(RosConverter::integratorOf(config, integrator, why));
+  EXPECT_EQ(integrator, IntegratorType::Xpbd);
+  EXPECT_EQ(why, "");
+}
+
+TEST(RosConverter, AnUnknownIntegratorIsRefusedQuotingAtMost32CharactersAndListingTheValidOnes)
+{
+  SimConfig config = SimConfig::__getDefault__();
+  config.integrator = std::string(1000, 'x');
+  IntegratorType integrator = IntegratorType::Rk4;
+  std::string why;
+  EXPECT_FALSE(RosConverter::integratorOf(config, integrator, why));
+  EXPECT_EQ(integrator, IntegratorType::Rk4);
+  EXPECT_EQ(why.find("integrator '" + std::string(32, 'x') + "...' is unknown; valid:"), 0u) << why;
+  for (const std::string& name : integratorNames())
+    EXPECT_NE(why.find(" " + name), std::string::npos) << name;
+  EXPECT_LT(why.size(), 200u);
+}
+
+TEST(RosConverter, ABodyConfigIsTheBodysMaterialFactors)
+{
+  BodyConfig config = BodyConfig::__getDefault__();
+  config.stiffness_scale = 2.0;
+  config.damping_scale = 0.5;
+  config.pressure_scale = 3.0;
+  const BodyScaling scaling = RosConverter::toBodyScaling(config);
+  EXPECT_EQ(scaling.stiffness, 2.0);
+  EXPECT_EQ(scaling.damping, 0.5);
+  EXPECT_EQ(scaling.pressure, 3.0);
+}
+
+TEST(World, ABodyHasAMaterialToTuneOnlyIfBuiltWithSpringsConstraintsOrCells)
+{
+  SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);
+  RopeDef rope;
+  rope.nodes = 3;
+  scene.bodies[0] = buildRope("rope", rope);
+  scene.bodies.push_back(buildHumanoid("person", HumanoidDef{}));
+  BodyDef pair;
+  pair.name = "pair";
+  pair.nodes = { NodeDef{ Vec3(1, 2, 3), 1.0 }, NodeDef{ Vec3(1, 2, 4), 1.0 } };
+  pair.constraints = { ConstraintDef{ 0, 1, 0.0, std::nullopt } };
+  scene.bodies.push_back(pair);
+  const World world = buildWorld(scene);
+  EXPECT_TRUE(world.hasMaterial(0));   // springs
+  EXPECT_FALSE(world.hasMaterial(1));  // kinematic nodes only
+  EXPECT_TRUE(world.hasMaterial(2));   // a constraint
 }
 
 }  // namespace

@@ -10,7 +10,14 @@ MaterialScaling::MaterialScaling(const Model& built)
   , built_constraints_(built.constraints)
   , built_cells_(built.cells)
   , scaling_(built.bodies.size())
+  , has_material_(built.bodies.size(), 0)
 {
+  for (const Spring& spring : built.springs)
+    has_material_[built.bodyOf(spring.a)] = 1;
+  for (const DistanceConstraint& constraint : built.constraints)
+    has_material_[built.bodyOf(constraint.a)] = 1;
+  for (const PressureCell& cell : built.cells)
+    has_material_[built.bodyOf(cell.nodes[0])] = 1;
 }
 
 void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& scaling)

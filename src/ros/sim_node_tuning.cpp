@@ -1,7 +1,6 @@
 // SimNode's live tuning (dynamic_reconfigure: ~ for the physics, ~<body> for each body's material) and
 // its health on /diagnostics.
 #include <cmath>
-#include <sstream>
 
 #include <ros/names.h>
 
@@ -16,36 +15,22 @@ namespace
 constexpr double kSlowRealTimeFactor = 0.9;
 }  // namespace
 
-SimConfig SimNode::simConfigFromWorld() const
-{
-  SimConfig config = SimConfig::__getDefault__();
-  config.integrator = integratorName(world_->integrator());
-  config.dt = world_->settings().dt;
-  config.substeps = world_->settings().substeps;
-  config.iterations = world_->settings().iterations;
-  config.gravity_x = world_->model().gravity.x();
-  config.gravity_y = world_->model().gravity.y();
-  config.gravity_z = world_->model().gravity.z();
-  config.drag = world_->model().drag;
-  return config;
-}
-
 void SimNode::startReconfigure()
 {
   sim_reconfigure_ = std::make_unique<ReconfigureServer<SimConfig>>(
-      private_nh_, simConfigFromWorld(), [this](const SimConfig& config) { return applySimConfig(config); });
-  for (const BodyDef& body : scene_.bodies)
+      private_nh_, RosConverter::toSimConfig(*world_), [this](const SimConfig& config) { return applySimConfig(config); });
+  for (std::size_t b = 0; b < world_->model().bodies.size(); ++b)
   {
-    if (body.springs.empty() && body.constraints.empty() && body.cells.empty())
+    if (!world_->hasMaterial(b))
       continue;  // nothing to tune (a humanoid: kinematic nodes only)
+    const std::string name = world_->model().bodies[b].name;
     std::string error;
-    if (!ros::names::validate(body.name, error))
+    if (!ros::names::validate(name, error))
     {
       ROS_WARN("%s: body '%s' cannot be tuned live: its name is no valid ROS name (%s)", name_.c_str(),
-               body.name.c_str(), error.c_str());
+               name.c_str(), error.c_str());
       continue;
     }
-    const std::string name = body.name;
     body_reconfigure_.emplace_back(name, std::make_unique<ReconfigureServer<BodyConfig>>(
         ros::NodeHandle(private_nh_, name), BodyConfig::__getDefault__(),
         [this, name](const BodyConfig& config) { return applyBodyConfig(name, config); }));
@@ -55,19 +40,11 @@ void SimNode::startReconfigure()
 std::string SimNode::applySimConfig(const SimConfig& config)
 {
   IntegratorType integrator;
-  if (!integratorFromName(config.integrator, integrator))
-  {
-    std::ostringstream why;
-    // Quoted back only as far as a name could be: the request may hold megabytes.
-    const std::size_t shown = 32;
-    why << "integrator '" << config.integrator.substr(0, shown) << (config.integrator.size() > shown ? "...'" : "'")
-        << " is unknown; valid:";
-    for (const std::string& name : integratorNames())
-      why << " " << name;
-    return why.str();
-  }
-  const Vec3 gravity(config.gravity_x, config.gravity_y, config.gravity_z);
-  const StepSettings settings{ config.dt, config.substeps, config.iterations };
+  std::string why;
+  if (!RosConverter::integratorOf(config, integrator, why))
+    return why;
+  const Vec3 gravity = RosConverter::gravityOf(config);
+  const StepSettings settings = RosConverter::stepSettingsOf(config);
   // Only what changed is set: a new integrator object (or a new dt) restarts multistep histories.
   if (integrator != world_->integrator())
     world_->setIntegrator(integrator);
@@ -89,7 +66,7 @@ std::string SimNode::applySimConfig(const SimConfig& config)
 
 std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& config)
 {
-  const BodyScaling scaling{ config.stiffness_scale, config.damping_scale, config.pressure_scale };
+  const BodyScaling scaling = RosConverter::toBodyScaling(config);
   try
   {
     if (!world_->setBodyScaling(body, scaling))

@@ -29,12 +29,15 @@ public:
   void set(Model& model, std::size_t body, const BodyScaling& scaling);
   /// The scaling last set for body `body` (all 1 if never set).
   const BodyScaling& of(std::size_t body) const { return scaling_.at(body); }
+  /// True if body `body` was built with springs, constraints or cells: a material to scale.
+  bool has(std::size_t body) const { return has_material_.at(body) != 0; }
 
 private:
   std::vector<Spring> built_springs_;
   std::vector<DistanceConstraint> built_constraints_;
   std::vector<PressureCell> built_cells_;
   std::vector<BodyScaling> scaling_;  ///< per body
+  std::vector<char> has_material_;    ///< per body
 };
 
 }  // namespace soft_body_sim

@@ -91,6 +91,9 @@ public:
   bool setBodyScaling(const std::string& body, const BodyScaling& scaling);
   /// The scaling last set for `body` (all 1 if never set or unknown).
   BodyScaling bodyScaling(const std::string& body) const;
+  /// True if body `body` (index into model().bodies) has a material to scale: springs, constraints or
+  /// cells (a humanoid, all kinematic nodes, has none).
+  bool hasMaterial(std::size_t body) const { return material_.has(body); }
 
   // --- anchors that follow a path, and grasping -----------------------------------------------------
   /// Every step, the anchor moves (as by moveAnchor) to path(t) at the step's end time t; an empty path

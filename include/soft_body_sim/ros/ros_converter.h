@@ -10,6 +10,8 @@
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
+#include "soft_body_sim/BodyConfig.h"
+#include "soft_body_sim/SimConfig.h"
 #include "soft_body_sim/SimState.h"
 #include "soft_body_sim/core/world.h"
 
@@ -47,6 +49,23 @@ public:
   static Vec3 toVec3(const geometry_msgs::Point& point) { return Vec3(point.x, point.y, point.z); }
   /// A translation [m], as it is.
   static Vec3 toVec3(const geometry_msgs::Vector3& vector) { return Vec3(vector.x, vector.y, vector.z); }
+
+  /// The world's live physics as the node's reconfigure config (~): integrator, dt, substeps,
+  /// iterations, gravity, drag.
+  static SimConfig toSimConfig(const World& world);
+  /// The integrator a config names; false (and why, quoting at most 32 characters of the name) if it
+  /// names none.
+  static bool integratorOf(const SimConfig& config, IntegratorType& integrator, std::string& why);
+  static StepSettings stepSettingsOf(const SimConfig& config)
+  {
+    return StepSettings{ config.dt, config.substeps, config.iterations };
+  }
+  static Vec3 gravityOf(const SimConfig& config) { return Vec3(config.gravity_x, config.gravity_y, config.gravity_z); }
+  /// A body's reconfigure config (~<body>) as its material factors.
+  static BodyScaling toBodyScaling(const BodyConfig& config)
+  {
+    return BodyScaling{ config.stiffness_scale, config.damping_scale, config.pressure_scale };
+  }
 };
 
 }  // namespace soft_body_sim

@@ -84,7 +84,6 @@ private:
   /// Applies `config` to the world; an empty string, or why it cannot.
   std::string applySimConfig(const SimConfig& config);
   std::string applyBodyConfig(const std::string& body, const BodyConfig& config);
-  SimConfig simConfigFromWorld() const;
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   /// Logs the divergence guard's catches of the last tick and measures the largest strain.
   void watchDivergence();
@@ -96,7 +95,7 @@ private:
   ros::NodeHandle private_nh_;
   std::string name_;
   std::string scene_path_;
-  SceneDef scene_;
+  SceneDef scene_;  ///< as loaded: its frame and rate, and what ~reset rebuilds; the World answers the rest
   std::unique_ptr<World> world_;
   double rate_ = 60.0;          ///< [Hz] of the timer
   double status_period_ = 0.0;  ///< [s] between status lines on the console; 0 = none
