@@ -53,11 +53,11 @@ class PackageEngine final : public Engine
 public:
   explicit PackageEngine(const SceneDef& scene) : world_(buildWorld(scene))
   {
-    if (!world_.model().planes.empty())
+    if (!world_.model().colliders.planes.empty())
       world_.observeIntegration([this](const Model& model, const State& state) {
-        for (const Plane& plane : model.planes)
+        for (const Plane& plane : model.colliders.planes)
           for (Eigen::Index i = 0; i < state.position.cols(); ++i)
-            penetration_ = std::max(penetration_, -(state.position.col(i) - plane.point).dot(plane.normal));
+            penetration_ = std::max(penetration_, -(state.position.col(i) - plane.point).dot(plane.normal.normalized()));
       });
   }
   void step() override { world_.step(); }

@@ -525,7 +525,7 @@ Problem jelly(const ProblemOptions& options)
     SceneDef scene = sceneWith(config);
     scene.physics.gravity = Vec3(0, 0, -kGravity);
     scene.physics.drag = 0.1;
-    scene.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 } };
+    scene.colliders.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 } };
     JellyDef def;
     def.corners = GridCorners{ Vec3(-0.1414, 0.0, 2.4899), Vec3(0.2449, 0.0, 2.3864), Vec3(-0.2449, 0.0, 2.1035) };
     scene.bodies.push_back(buildJelly("jelly", def));

@@ -99,7 +99,7 @@ SceneDef everyFeatureScene(IntegratorType integrator)
   scene.physics.step.substeps = 2;
   scene.physics.step.iterations = 2;
   scene.physics.drag = 0.1;
-  scene.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.2, 0.5 } };
+  scene.colliders.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.2, 0.5 } };
 
   RopeDef rope;
   rope.nodes = 12;

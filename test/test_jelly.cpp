@@ -491,8 +491,8 @@ TEST(JellyDrop, TheScenesCornersAreTheOnesTheTestDrops)
   for (const NodeDef& node : built.nodes)
     lowest = std::min(lowest, node.position.z());
   EXPECT_NEAR(lowest, 2.0, 1e-12);
-  ASSERT_EQ(scene.planes.size(), 1u);
-  EXPECT_EQ(scene.planes[0].restitution, 0.0);
+  ASSERT_EQ(scene.colliders.planes.size(), 1u);
+  EXPECT_EQ(scene.colliders.planes[0].restitution, 0.0);
 }
 
 // --- failure 2: no jitter at rest ----------------------------------------------------------------------------

@@ -982,13 +982,13 @@ bodies:
     anchors: [{name: first, node: 0}, {name: last, node: -1, frame: gripper_link}]
 )",
                                     "planes.yaml");
-  ASSERT_EQ(scene.planes.size(), 2u);
-  expectVec3(scene.planes[0].point, 0, 0, -1);
-  expectVec3(scene.planes[0].normal, 0, 0, 2);  // normalised when the world is built
-  EXPECT_EQ(scene.planes[0].restitution, 0.5);
-  EXPECT_EQ(scene.planes[0].friction, 0.3);
-  EXPECT_EQ(scene.planes[1].restitution, 0.0);
-  EXPECT_EQ(scene.planes[1].friction, 0.0);
+  ASSERT_EQ(scene.colliders.planes.size(), 2u);
+  expectVec3(scene.colliders.planes[0].point, 0, 0, -1);
+  expectVec3(scene.colliders.planes[0].normal, 0, 0, 2);
+  EXPECT_EQ(scene.colliders.planes[0].restitution, 0.5);
+  EXPECT_EQ(scene.colliders.planes[0].friction, 0.3);
+  EXPECT_EQ(scene.colliders.planes[1].restitution, 0.0);
+  EXPECT_EQ(scene.colliders.planes[1].friction, 0.0);
   const BodyDef& body = scene.bodies[0];
   ASSERT_EQ(body.anchors.size(), 2u);
   EXPECT_EQ(body.anchors[0].name, "first");
@@ -1006,7 +1006,9 @@ bodies:
   ASSERT_EQ(world.model().anchors.size(), 2u);
   EXPECT_EQ(world.model().anchors[0].frame, "");
   EXPECT_EQ(world.model().anchors[1].frame, "gripper_link");
-  EXPECT_EQ(world.model().planes[0].normal, Vec3(0, 0, 1));
+  // The model holds the colliders as declared; the contact stage normalises its own copy (test_world's
+  // bounce on a plane of normal (0, 0, 3)).
+  EXPECT_EQ(world.model().colliders.planes[0].normal, Vec3(0, 0, 2));
 }
 
 // --- files -------------------------------------------------------------------------------------

@@ -41,7 +41,7 @@ World nodeAboveFloor(IntegratorType integrator, double dt, const Vec3& position,
 {
   SceneDef scene = oneBodyScene(integrator, dt);
   scene.physics.gravity = Vec3(0, 0, -9.81);
-  scene.planes = { Plane{ Vec3::Zero(), Vec3(0, 0, 3), restitution, friction } };
+  scene.colliders.planes = { Plane{ Vec3::Zero(), Vec3(0, 0, 3), restitution, friction } };
   scene.bodies[0].nodes = { NodeDef{ position, 1.0, velocity, false } };
   return buildWorld(scene);
 }
@@ -129,7 +129,7 @@ TEST(Planes, ALoadedNodeOnABouncyFloorComesToRest)
   // m (e 2 g h)^2 / 2 ~ 7e-4 J and stays there.
   SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);
   scene.physics.gravity = Vec3(0, 0, -9.81);
-  scene.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.9, 0.0 } };
+  scene.colliders.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.9, 0.0 } };
   scene.bodies[0].nodes = { NodeDef{ Vec3(0, 0, 0), 1.0 }, NodeDef{ Vec3(0, 0, 0.1), 10.0 } };
   scene.bodies[0].springs = { SpringDef{ 0, 1, 1e4, 400.0, 0.1 } };  // damping ratio 0.6
   World world = buildWorld(scene);
@@ -147,7 +147,7 @@ TEST(Planes, ALoadedNodeOnABouncyFloorComesToRest)
 TEST(Planes, PinnedNodesAreLeftWhereTheyAre)
 {
   SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);
-  scene.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.0 } };
+  scene.colliders.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.0 } };
   scene.bodies[0].nodes = { NodeDef{ Vec3(0, 0, -1), 1.0, Vec3::Zero(), true } };
   World world = buildWorld(scene);
   world.step();

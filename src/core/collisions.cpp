@@ -1,8 +1,23 @@
 #include "soft_body_sim/core/collisions.h"
 
+#include <stdexcept>
+#include <utility>
+
 namespace soft_body_sim
 {
-bool collideWithPlanes(const Model& model, State& state, double resting_speed, std::vector<std::uint8_t>& touching)
+PlaneContacts::PlaneContacts(std::vector<Plane> planes, int nodes)
+  : planes_(std::move(planes)), touching_(static_cast<std::size_t>(nodes), 0)
+{
+  for (Plane& plane : planes_)
+  {
+    if (!(plane.normal.norm() > 0.0))
+      throw std::invalid_argument("plane normal must not be zero");
+    plane.normal.normalize();
+  }
+}
+
+bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, State& state, double resting_speed,
+                       std::vector<std::uint8_t>& touching)
 {
   touching.resize(static_cast<std::size_t>(model.nodeCount()), 0);
   bool touched_any = false;
@@ -12,7 +27,7 @@ bool collideWithPlanes(const Model& model, State& state, double resting_speed, s
       continue;
     const bool was_touching = touching[static_cast<std::size_t>(i)] != 0;
     bool touched = false;
-    for (const Plane& plane : model.planes)
+    for (const Plane& plane : planes)
     {
       const double depth = (state.position.col(i) - plane.point).dot(plane.normal);
       if (depth >= 0.0)

@@ -7,8 +7,8 @@ namespace soft_body_sim
 std::vector<std::unique_ptr<ColliderKind>> makeColliderKinds(const Model& model)
 {
   std::vector<std::unique_ptr<ColliderKind>> kinds;
-  if (!model.planes.empty())
-    kinds.push_back(std::make_unique<PlaneContacts>(model.nodeCount()));
+  if (!model.colliders.planes.empty())
+    kinds.push_back(std::make_unique<PlaneContacts>(model.colliders.planes, model.nodeCount()));
   return kinds;
 }
 

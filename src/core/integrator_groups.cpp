@@ -82,7 +82,7 @@ void IntegratorGroups::rebuild(const Model& model)
     for (int i = 0; i < m.nodeCount(); ++i)
       if (!mine(i))
         m.inverse_mass[i] = 0.0;
-    // The elements that touch a node of the group (the others belong to other groups); no planes:
+    // The elements that touch a node of the group (the others belong to other groups); no colliders:
     // contact is the world's stage, not the group's.
     m.springs.clear();
     std::copy_if(model.springs.begin(), model.springs.end(), std::back_inserter(m.springs),
@@ -94,7 +94,7 @@ void IntegratorGroups::rebuild(const Model& model)
     std::copy_if(model.cells.begin(), model.cells.end(), std::back_inserter(m.cells), [&](const PressureCell& c) {
       return std::any_of(std::begin(c.nodes), std::end(c.nodes), mine);
     });
-    m.planes.clear();
+    m.colliders = Colliders{};
     groups_.push_back(std::move(group));
   }
 }

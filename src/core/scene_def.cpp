@@ -42,13 +42,7 @@ World buildWorld(const SceneDef& scene)
   Model model;
   model.gravity = scene.physics.gravity;
   model.drag = scene.physics.drag;
-  for (Plane plane : scene.planes)
-  {
-    if (!(plane.normal.norm() > 0.0))
-      throw std::invalid_argument("plane normal must not be zero");
-    plane.normal.normalize();
-    model.planes.push_back(plane);
-  }
+  model.colliders = scene.colliders;
   model.mass.resize(node_count);
   model.inverse_mass.resize(node_count);
   State state;

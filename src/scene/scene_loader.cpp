@@ -158,7 +158,7 @@ SceneDef readScene(const Context& ctx, const Field& root)
     scene.physics = readPhysics(ctx, *value);
   if (const std::optional<Field> planes = optionalKey(root, "planes"))
     for (const Field& item : requireList(ctx, *planes))
-      scene.planes.push_back(readPlane(ctx, item));
+      scene.colliders.planes.push_back(readPlane(ctx, item));
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error

@@ -1,4 +1,4 @@
-// Contact with the scene's planes (walls and floors).
+// Contact with the scene's planes (walls and floors): the contact stage's first kind of collider.
 #pragma once
 
 #include <cstdint>
@@ -17,21 +17,25 @@ namespace soft_body_sim
 /// flag per node, updated here) and approaches faster than `resting_speed` [m/s]: a node resting on a
 /// floor, alone or under the weight of others, gains approach speed every step and must not jitter.
 /// Returns true if any node was touched.
-bool collideWithPlanes(const Model& model, State& state, double resting_speed, std::vector<std::uint8_t>& touching);
+/// `planes` have unit normals.
+bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, State& state, double resting_speed,
+                       std::vector<std::uint8_t>& touching);
 
-/// Model::planes as a kind of collider of the contact stage.
+/// The scene's planes as a kind of collider of the contact stage.
 class PlaneContacts final : public ColliderKind
 {
 public:
-  explicit PlaneContacts(int nodes) : touching_(static_cast<std::size_t>(nodes), 0) {}
+  /// Keeps the planes with unit normals; throws std::invalid_argument on a zero normal.
+  PlaneContacts(std::vector<Plane> planes, int nodes);
 
   /// A node resting on a plane approaches it by ~|g| h per sub-step; twice that does not bounce.
   bool resolve(const Model& model, State& state, double h) override
   {
-    return collideWithPlanes(model, state, 2.0 * model.gravity.norm() * h, touching_);
+    return collideWithPlanes(planes_, model, state, 2.0 * model.gravity.norm() * h, touching_);
   }
 
 private:
+  std::vector<Plane> planes_;
   std::vector<std::uint8_t> touching_;  ///< per node: on a plane after the last sub-step
 };
 

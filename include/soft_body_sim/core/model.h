@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 
+#include "soft_body_sim/core/colliders.h"
+
 namespace soft_body_sim
 {
 /// A point or direction in the scene's fixed frame [m].
@@ -58,16 +60,6 @@ struct BodyRange
   int count = 0;
 };
 
-/// A wall or floor: the half-space (x - point) . normal >= 0 is free space, nodes are pushed out of the
-/// other side. Contacts bounce with `restitution` and slide with Coulomb `friction`.
-struct Plane
-{
-  Vec3 point = Vec3::Zero();           ///< a point on the plane [m]
-  Vec3 normal = Vec3::UnitZ();         ///< unit normal pointing into free space
-  double restitution = 0.0;            ///< normal speed kept after a bounce, in [0, 1]
-  double friction = 0.0;               ///< Coulomb coefficient [-], >= 0
-};
-
 /// A named node of a body that the caller moves kinematically (its node is pinned).
 struct Anchor
 {
@@ -90,7 +82,7 @@ struct Model
   std::vector<DistanceConstraint> constraints;
   std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then
   std::vector<BodyRange> bodies;
-  std::vector<Plane> planes;
+  Colliders colliders;  ///< as the scene declares them; the contact stage prepares its own copies
   std::vector<Anchor> anchors;
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  ///< [m/s^2]
   double drag = 0.0;                      ///< linear air drag [1/s]: a -= drag * v on free nodes

@@ -95,7 +95,7 @@ struct SceneDef
   std::string frame_id = "world";  ///< fixed frame of the simulation
   double rate = 60.0;              ///< [Hz] at which the ROS node advances and publishes, > 0
   PhysicsDef physics;
-  std::vector<Plane> planes;  ///< walls and floors every body collides with (normals need not be unit)
+  Colliders colliders;  ///< what every body collides with (colliders.h)
   std::vector<BodyDef> bodies;
 };
 
@@ -134,8 +134,8 @@ int resolveNodeIndex(long long index, int node_count);
 
 /// Flattens the bodies into one node array (body k's nodes follow body k-1's), pins anchored nodes,
 /// makes the controllers and returns the world. Expects a valid scene (the loader checks); throws
-/// std::invalid_argument on an index out of range, a zero plane or cell normal, or a cell whose rest
-/// area is not positive.
+/// std::invalid_argument on an index out of range, a bad collider (a zero plane normal), a zero cell
+/// normal, or a cell whose rest area is not positive.
 World buildWorld(const SceneDef& scene);
 
 }  // namespace soft_body_sim
