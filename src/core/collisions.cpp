@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include "contact_response.h"
+
 namespace soft_body_sim
 {
 PlaneContacts::PlaneContacts(std::vector<Plane> planes, int nodes)
@@ -16,8 +18,8 @@ PlaneContacts::PlaneContacts(std::vector<Plane> planes, int nodes)
   }
 }
 
-bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, State& state, double resting_speed,
-                       std::vector<std::uint8_t>& touching)
+bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, const NodeArray& start, State& state,
+                       double resting_speed, std::vector<std::uint8_t>& touching, double h)
 {
   touching.resize(static_cast<std::size_t>(model.nodeCount()), 0);
   bool touched_any = false;
@@ -29,23 +31,13 @@ bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, Sta
     bool touched = false;
     for (const Plane& plane : planes)
     {
-      const double depth = (state.position.col(i) - plane.point).dot(plane.normal);
-      if (depth >= 0.0)
+      const double depth = model.contact_radius[i] - (state.position.col(i) - plane.point).dot(plane.normal);
+      if (!(depth > 0.0))
         continue;
       touched = true;
-      state.position.col(i) -= depth * plane.normal;
-      const Vec3 v = state.velocity.col(i);
-      const double normal_speed = v.dot(plane.normal);
-      if (normal_speed >= 0.0)
-        continue;
-      const bool impact = !was_touching && -normal_speed > resting_speed;
-      const double bounce_speed = impact ? -plane.restitution * normal_speed : 0.0;
-      Vec3 tangential = v - normal_speed * plane.normal;
-      const double tangential_speed = tangential.norm();
-      const double friction_loss = plane.friction * (bounce_speed - normal_speed);
-      if (tangential_speed > 0.0)
-        tangential *= std::max(0.0, 1.0 - friction_loss / tangential_speed);
-      state.velocity.col(i) = tangential + bounce_speed * plane.normal;
+      const bool impact = !was_touching && -state.velocity.col(i).dot(plane.normal) > resting_speed;
+      leaveSurface({ plane.normal, Vec3::Zero(), plane.friction, plane.restitution }, depth, impact, h,
+                   state.position.col(i) - start.col(i), state.position.col(i), state.velocity.col(i));
     }
     touching[static_cast<std::size_t>(i)] = touched ? 1 : 0;
     touched_any = touched_any || touched;

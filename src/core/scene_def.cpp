@@ -45,6 +45,7 @@ World buildWorld(const SceneDef& scene)
   model.colliders = scene.colliders;
   model.mass.resize(node_count);
   model.inverse_mass.resize(node_count);
+  model.contact_radius.resize(node_count);
   State state;
   std::vector<BodyController> controllers;
   state.position.resize(3, node_count);
@@ -59,6 +60,7 @@ World buildWorld(const SceneDef& scene)
       const NodeDef& node = body.nodes[static_cast<std::size_t>(k)];
       model.mass[first + k] = node.mass;
       model.inverse_mass[first + k] = node.pinned ? 0.0 : 1.0 / node.mass;
+      model.contact_radius[first + k] = body.contact_radius;
       state.position.col(first + k) = node.position;
       state.velocity.col(first + k) = node.velocity;
     }

@@ -23,8 +23,11 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
   , guard_(state_, model_.bodies.size())
 {
   const Eigen::Index n = model_.nodeCount();
-  if (model_.inverse_mass.size() != n || state_.position.cols() != n || state_.velocity.cols() != n)
-    throw std::invalid_argument("World: mass, inverse mass, position and velocity sizes differ");
+  if (model_.contact_radius.size() == 0)
+    model_.contact_radius.setZero(n);  // a model made without radii: points
+  if (model_.inverse_mass.size() != n || model_.contact_radius.size() != n || state_.position.cols() != n ||
+      state_.velocity.cols() != n)
+    throw std::invalid_argument("World: mass, inverse mass, contact radius, position and velocity sizes differ");
   if (!(settings_.dt > 0.0) || settings_.substeps < 1 || settings_.iterations < 1)
     throw std::invalid_argument("World: dt must be > 0, substeps and iterations >= 1");
   for (const Anchor& anchor : model_.anchors)
@@ -68,6 +71,7 @@ void World::moveAnchors(double h)
 
 void World::integrate(double h)
 {
+  contacts_.remember(state_);
   integrators_.step(model_, state_, h, settings_.iterations);
   if (integration_observer_)
     integration_observer_(model_, state_);

@@ -1,11 +1,13 @@
 // What the bodies collide with, as the scene declares it: plain data, held whole in Model::colliders and
 // copied whole from SceneDef. Each kind of collider is resolved by its own ColliderKind (contact.h),
-// which checks and prepares its shapes when the world is built.
+// which checks and prepares its shapes when the world is built and keeps their live poses.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace soft_body_sim
 {
@@ -19,10 +21,64 @@ struct Plane
   double friction = 0.0;                              ///< Coulomb coefficient [-], >= 0
 };
 
+/// Where a rigid collider is and how it moves, and its surface. Its pose moves at constant `velocity`
+/// and `angular_velocity` (about its own origin) unless the caller sets it (a tf frame, World::moveCollider).
+struct ColliderPlacement
+{
+  std::string name;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();                 ///< [m] of its origin
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();    ///< of its local axes (unit)
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();                 ///< [m/s]
+  Eigen::Vector3d angular_velocity = Eigen::Vector3d::Zero();         ///< [rad/s], in the scene frame
+  double friction = 0.0;     ///< Coulomb coefficient [-], >= 0
+  double restitution = 0.0;  ///< normal speed kept after a bounce, in [0, 1]
+  std::string frame;         ///< a tf frame the ROS node makes it follow (pose relative to it); empty = none
+};
+
+/// A ball of `radius` [m] about its origin.
+struct Sphere
+{
+  ColliderPlacement at;
+  double radius = 0.1;  ///< [m], > 0
+};
+
+/// A segment of `length` [m] along its local z axis, centred on its origin, thickened by `radius` [m]
+/// (hemispheres at z = +-length / 2).
+struct Capsule
+{
+  ColliderPlacement at;
+  double radius = 0.05;  ///< [m], > 0
+  double length = 0.5;   ///< [m] between the end centres, >= 0
+};
+
+/// A box of full extents `size` [m] along its local x, y, z, centred on its origin.
+struct Box
+{
+  ColliderPlacement at;
+  Eigen::Vector3d size = Eigen::Vector3d::Constant(0.1);  ///< [m], each > 0
+};
+
 /// Every collider of a scene, by kind. A scene without any has no contact stage at all.
 struct Colliders
 {
   std::vector<Plane> planes;
+  std::vector<Sphere> spheres;
+  std::vector<Capsule> capsules;
+  std::vector<Box> boxes;
 };
+
+/// The nearest point of a shape's surface to a point, in the shape's local frame.
+struct SurfaceDistance
+{
+  double distance = 0.0;                            ///< [m] signed: > 0 outside, < 0 inside
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< unit outward normal there
+  Eigen::Vector3d closest = Eigen::Vector3d::Zero();  ///< the surface point [m]; point = closest + distance normal
+};
+
+/// `local` is a point in the shape's local frame [m]. Where the normal is not unique (the centre of a
+/// sphere, the axis of a capsule, equidistant box faces) one of the candidates is returned.
+SurfaceDistance surfaceDistance(const Sphere& sphere, const Eigen::Vector3d& local);
+SurfaceDistance surfaceDistance(const Capsule& capsule, const Eigen::Vector3d& local);
+SurfaceDistance surfaceDistance(const Box& box, const Eigen::Vector3d& local);
 
 }  // namespace soft_body_sim

@@ -78,6 +78,7 @@ struct Model
 {
   Eigen::VectorXd mass;          ///< [kg] per node (kept for pinned nodes too, for reporting)
   Eigen::VectorXd inverse_mass;  ///< [1/kg] per node, 0 for pinned nodes
+  Eigen::VectorXd contact_radius;  ///< [m] per node: how far it keeps from colliders (0 = a point)
   std::vector<Spring> springs;
   std::vector<DistanceConstraint> constraints;
   std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then

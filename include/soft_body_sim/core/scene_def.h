@@ -77,6 +77,7 @@ struct BodyDef
   std::vector<CellDef> cells;  ///< pressure cells (jelly); usually empty
   std::vector<AnchorDef> anchors;
   ControllerFactory controller;  ///< empty for passive bodies
+  double contact_radius = 0.0;   ///< [m] >= 0: how far its nodes keep from colliders (0 = points)
 };
 
 struct PhysicsDef

@@ -73,6 +73,15 @@ public:
   /// True if body `body` (index into model().bodies) takes a target.
   bool takesTarget(std::size_t body) const;
 
+  /// The current pose of every drawable collider (spheres, capsules, boxes), in declaration order by kind.
+  std::vector<ColliderPose> colliderPoses() const { return contacts_.poses(); }
+  /// Places collider `name` at `position` [m] with `orientation` (normalised here) from the next
+  /// sub-step on; false if there is none of that name.
+  bool moveCollider(const std::string& name, const Vec3& position, const Eigen::Quaterniond& orientation)
+  {
+    return contacts_.setPose(name, position, orientation);
+  }
+
   /// Sets a node's position [m] and velocity [m/s] directly.
   void setNode(int node, const Vec3& position, const Vec3& velocity);
 

@@ -1,0 +1,101 @@
+// Contact with rigid shapes (spheres, capsules, boxes): one template over the shape, whose geometry is
+// surfaceDistance (colliders.h). Private to the core.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <vector>
+
+#include "contact_response.h"
+#include "soft_body_sim/core/contact.h"
+
+namespace soft_body_sim
+{
+/// Throws std::invalid_argument unless the placement is usable: a finite pose and motion, a non-zero
+/// orientation (normalised here), friction >= 0 and restitution in [0, 1].
+void preparePlacement(ColliderPlacement& at);
+
+template <typename Shape>
+class ShapeContacts final : public ColliderKind
+{
+public:
+  ShapeContacts(std::vector<Shape> shapes, int nodes)
+    : shapes_(std::move(shapes)), touching_(static_cast<std::size_t>(nodes), 0)
+  {
+    for (Shape& shape : shapes_)
+      preparePlacement(shape.at);
+  }
+
+  bool resolve(const Model& model, const NodeArray& start, State& state, double h) override
+  {
+    move(h);
+    // A node resting on a shape approaches it by ~|g| h per sub-step; twice that does not bounce.
+    const double resting_speed = 2.0 * model.gravity.norm() * h;
+    bool touched_any = false;
+    for (int i = 0; i < model.nodeCount(); ++i)
+    {
+      if (!model.isFree(i))
+        continue;
+      const bool was_touching = touching_[static_cast<std::size_t>(i)] != 0;
+      bool touched = false;
+      const double radius = model.contact_radius[i];
+      for (const Shape& shape : shapes_)
+      {
+        const ColliderPlacement& at = shape.at;
+        const Vec3 local = at.orientation.conjugate() * (Vec3(state.position.col(i)) - at.position);
+        const SurfaceDistance surface = surfaceDistance(shape, local);
+        const double depth = radius - surface.distance;
+        if (!(depth > 0.0))
+          continue;
+        touched = true;
+        const Vec3 normal = at.orientation * surface.normal;
+        const Vec3 contact = at.position + at.orientation * surface.closest;
+        const Vec3 velocity = at.velocity + at.angular_velocity.cross(contact - at.position);
+        const double approach = -(Vec3(state.velocity.col(i)) - velocity).dot(normal);
+        leaveSurface({ normal, velocity, at.friction, at.restitution }, depth, !was_touching && approach > resting_speed,
+                     h, state.position.col(i) - start.col(i), state.position.col(i), state.velocity.col(i));
+      }
+      touching_[static_cast<std::size_t>(i)] = touched ? 1 : 0;
+      touched_any = touched_any || touched;
+    }
+    return touched_any;
+  }
+
+  void appendPoses(std::vector<ColliderPose>& poses) const override
+  {
+    for (const Shape& shape : shapes_)
+      poses.push_back(ColliderPose::of(shape));
+  }
+
+  bool setPose(const std::string& name, const Vec3& position, const Eigen::Quaterniond& orientation) override
+  {
+    for (Shape& shape : shapes_)
+      if (shape.at.name == name)
+      {
+        shape.at.position = position;
+        shape.at.orientation = orientation.normalized();
+        return true;
+      }
+    return false;
+  }
+
+private:
+  /// Every shape moves by its constant velocity and turns by its angular velocity over h.
+  void move(double h)
+  {
+    for (Shape& shape : shapes_)
+    {
+      ColliderPlacement& at = shape.at;
+      at.position += h * at.velocity;
+      const double angle = at.angular_velocity.norm() * h;
+      if (angle > 0.0)
+        at.orientation = (Eigen::Quaterniond(Eigen::AngleAxisd(angle, at.angular_velocity.normalized())) *
+                          at.orientation).normalized();
+    }
+  }
+
+  std::vector<Shape> shapes_;
+  std::vector<std::uint8_t> touching_;  ///< per node: on one of these shapes after the last sub-step
+};
+
+}  // namespace soft_body_sim

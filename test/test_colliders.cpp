@@ -1,0 +1,265 @@
+// Colliders (colliders.h, contact.h): each shape's distance, normal and closest point against a brute-force
+// reference; Coulomb friction on a tilted box against the closed form of a block on an incline; a
+// conveyor dragging a node by friction relative to its own motion; a cloth dropped onto a sphere kept
+// outside it by its thickness.
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "soft_body_sim/core/bodies/cloth.h"
+#include "soft_body_sim/core/contact.h"
+#include "test_util.h"
+
+namespace soft_body_sim::test
+{
+namespace
+{
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kGravity = 9.81;
+
+// --- geometry against brute force ---------------------------------------------------------------------
+
+/// Points on the unit sphere, spread evenly (a Fibonacci lattice).
+std::vector<Vec3> unitSpherePoints(int count)
+{
+  std::vector<Vec3> points;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (int k = 0; k < count; ++k)
+  {
+    const double z = 1.0 - 2.0 * (k + 0.5) / count;
+    const double r = std::sqrt(1.0 - z * z);
+    points.emplace_back(r * std::cos(golden * k), r * std::sin(golden * k), z);
+  }
+  return points;
+}
+
+/// A dense sampling of a surface and the spacing s of its samples: every surface point is within s of
+/// one of them.
+struct SampledSurface
+{
+  std::vector<Vec3> points;
+  double spacing = 0.0;
+};
+
+SampledSurface sample(const Sphere& sphere)
+{
+  SampledSurface s;
+  for (const Vec3& u : unitSpherePoints(40000))
+    s.points.push_back(sphere.radius * u);
+  s.spacing = sphere.radius * std::sqrt(4.0 * kPi / 40000.0);
+  return s;
+}
+
+SampledSurface sample(const Capsule& capsule)
+{
+  SampledSurface s;
+  const double r = capsule.radius, half = 0.5 * capsule.length;
+  for (const Vec3& u : unitSpherePoints(20000))  // the two hemispheres
+    s.points.push_back(r * u + Vec3(0, 0, u.z() >= 0.0 ? half : -half));
+  const int around = 400, along = 600;
+  for (int i = 0; i < around; ++i)
+    for (int j = 0; j <= along; ++j)
+    {
+      const double a = 2.0 * kPi * i / around;
+      s.points.emplace_back(r * std::cos(a), r * std::sin(a), -half + capsule.length * j / along);
+    }
+  s.spacing = std::max({ r * std::sqrt(4.0 * kPi / 20000.0), 2.0 * kPi * r / around, capsule.length / along }) * 2.0;
+  return s;
+}
+
+SampledSurface sample(const Box& box)
+{
+  SampledSurface s;
+  const Vec3 half = 0.5 * box.size;
+  const double step = 0.004;
+  for (int axis = 0; axis < 3; ++axis)
+  {
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    const int nu = static_cast<int>(std::ceil(box.size[u] / step)), nv = static_cast<int>(std::ceil(box.size[v] / step));
+    for (const double side : { -1.0, 1.0 })
+      for (int i = 0; i <= nu; ++i)
+        for (int j = 0; j <= nv; ++j)
+        {
+          Vec3 p;
+          p[axis] = side * half[axis];
+          p[u] = -half[u] + box.size[u] * i / nu;
+          p[v] = -half[v] + box.size[v] * j / nv;
+          s.points.push_back(p);
+        }
+  }
+  s.spacing = step * std::sqrt(2.0);
+  return s;
+}
+
+/// Inside tests that do not use surfaceDistance.
+bool inside(const Sphere& sphere, const Vec3& p) { return p.norm() < sphere.radius; }
+bool inside(const Capsule& capsule, const Vec3& p)
+{
+  const double z = std::max(-0.5 * capsule.length, std::min(0.5 * capsule.length, p.z()));
+  return (p - Vec3(0, 0, z)).norm() < capsule.radius;
+}
+bool inside(const Box& box, const Vec3& p) { return ((p.cwiseAbs() - 0.5 * box.size).array() < 0.0).all(); }
+
+template <typename Shape>
+void expectAgreesWithBruteForce(const Shape& shape, const char* name)
+{
+  const SampledSurface surface = sample(shape);
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> coordinate(-0.6, 0.6);
+  for (int k = 0; k < 300; ++k)
+  {
+    const Vec3 p(coordinate(random), coordinate(random), coordinate(random));
+    double nearest = 1e9;
+    for (const Vec3& q : surface.points)
+      nearest = std::min(nearest, (p - q).norm());
+    const SurfaceDistance d = surfaceDistance(shape, p);
+    SCOPED_TRACE(std::string(name) + " at (" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ", " +
+                 std::to_string(p.z()) + ")");
+    // The samples lie on the surface: their nearest is never nearer than the true distance, and at most
+    // one spacing farther.
+    EXPECT_LE(std::abs(d.distance), nearest + 1e-12);
+    EXPECT_GE(std::abs(d.distance), nearest - surface.spacing);
+    EXPECT_EQ(d.distance < 0.0, inside(shape, p));
+    EXPECT_NEAR(d.normal.norm(), 1.0, 1e-12);
+    // The closest point is on the surface (near a sample) and the point lies along the normal from it.
+    double closest_to_sample = 1e9;
+    for (const Vec3& q : surface.points)
+      closest_to_sample = std::min(closest_to_sample, (d.closest - q).norm());
+    EXPECT_LE(closest_to_sample, surface.spacing);
+    EXPECT_LT((d.closest + d.distance * d.normal - p).norm(), 1e-12);
+  }
+}
+
+TEST(ColliderGeometry, DistanceNormalAndClosestPointAgreeWithABruteForceReference)
+{
+  Sphere sphere;
+  sphere.radius = 0.3;
+  Capsule capsule;
+  capsule.radius = 0.12;
+  capsule.length = 0.5;
+  Box box;
+  box.size = Vec3(0.5, 0.3, 0.2);
+  expectAgreesWithBruteForce(sphere, "sphere");
+  expectAgreesWithBruteForce(capsule, "capsule");
+  expectAgreesWithBruteForce(box, "box");
+}
+
+// --- a node on a tilted box ----------------------------------------------------------------------------
+
+/// One free node of 1 kg resting on the top face of a large box tilted by `theta` about the x axis.
+SceneDef nodeOnTiltedBox(IntegratorType integrator, double theta, double friction, double dt)
+{
+  SceneDef scene = oneBodyScene(integrator, dt);
+  scene.physics.gravity = Vec3(0, 0, -kGravity);
+  Box box;
+  box.at.name = "ramp";
+  box.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(theta, Vec3::UnitX()));
+  box.at.friction = friction;
+  box.size = Vec3(10.0, 10.0, 0.2);  // the fastest slide covers 2.2 m in the test
+  scene.colliders.boxes.push_back(box);
+  scene.bodies[0].nodes = { NodeDef{ box.at.orientation * Vec3(0, 0, 0.1), 1.0, Vec3::Zero(), false } };
+  return scene;
+}
+
+// A block on an incline of angle theta with Coulomb friction mu stays put for tan(theta) < mu and
+// otherwise slides down with a = g (sin(theta) - mu cos(theta)). At a ROS node's step (1/240 s) the
+// discrete slide s_n = a h^2 n (n + 1) / 2 differs from a t^2 / 2 by 1/n = 0.4 % at n = 240.
+TEST(ColliderFriction, ANodeOnATiltedBoxStaysPutBelowTheFrictionAngleAndSlidesAtTheClosedFormAbove)
+{
+  const double mu = 0.5, dt = 1.0 / 240.0;
+  for (IntegratorType integrator : stableIntegrators(nodeOnTiltedBox(IntegratorType::Xpbd, 0.3, mu, dt)))
+  {
+    SCOPED_TRACE(integratorName(integrator));
+    for (const double degrees : { 10.0, 25.0, 26.0, 35.0, 50.0 })
+    {
+      SCOPED_TRACE(std::to_string(degrees) + " degrees");
+      const double theta = degrees * kPi / 180.0;
+      World world = buildWorld(nodeOnTiltedBox(integrator, theta, mu, dt));
+      const Vec3 start = world.state().position.col(0);
+      const Vec3 down_slope = Eigen::AngleAxisd(theta, Vec3::UnitX()) * Vec3(0, -1, 0);
+      for (int n = 0; n < 240; ++n)
+        world.step();
+      const Vec3 moved = Vec3(world.state().position.col(0)) - start;
+      const double slid = moved.dot(down_slope);
+      if (std::tan(theta) < mu)
+      {
+        EXPECT_LT(moved.norm(), 1e-12);
+      }
+      else
+      {
+        const double expected = 0.5 * kGravity * (std::sin(theta) - mu * std::cos(theta));
+        EXPECT_NEAR(slid, expected, 0.01 * expected);
+      }
+      // Never into the box: on or above its top face.
+      const Vec3 local = Eigen::AngleAxisd(theta, Vec3::UnitX()).inverse() * Vec3(world.state().position.col(0));
+      EXPECT_GE(local.z(), 0.1 - 1e-12);
+    }
+  }
+}
+
+// A node resting on a conveyor (a box moving at V) is dragged by kinetic friction: its speed grows as
+// mu g t until it reaches V at t = V / (mu g), then rides along.
+TEST(ColliderFriction, AMovingBoxDragsARestingNodeUpToItsOwnSpeed)
+{
+  const double mu = 0.4, speed = 0.5, dt = 1.0 / 240.0;
+  SceneDef scene = nodeOnTiltedBox(IntegratorType::SemiImplicitEuler, 0.0, mu, dt);
+  scene.colliders.boxes[0].at.velocity = Vec3(speed, 0, 0);
+  for (IntegratorType integrator : stableIntegrators(scene))
+  {
+    SCOPED_TRACE(integratorName(integrator));
+    scene.physics.integrator = integrator;
+    World world = buildWorld(scene);
+    const int ramp_steps = 24;  // 0.1 s < V / (mu g) = 0.127 s
+    for (int n = 0; n < ramp_steps; ++n)
+      world.step();
+    EXPECT_NEAR(world.state().velocity(0, 0), mu * kGravity * ramp_steps * dt, 0.02 * mu * kGravity * ramp_steps * dt);
+    for (int n = 0; n < 96; ++n)
+      world.step();
+    EXPECT_NEAR(world.state().velocity(0, 0), speed, 1e-9);
+    EXPECT_NEAR(world.state().position(2, 0), 0.1, 1e-9);
+  }
+}
+
+// --- a cloth onto a sphere -------------------------------------------------------------------------------
+
+TEST(ColliderContact, AClothDroppedOntoASphereRestsOnItNoNodeCloserThanRadiusPlusThickness)
+{
+  const double radius = 0.3, thickness = 0.01;
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 120.0, 4, 2 };
+  scene.physics.drag = 0.5;
+  Sphere sphere;
+  sphere.at.name = "ball";
+  sphere.at.friction = 0.5;
+  sphere.radius = radius;
+  scene.colliders.spheres.push_back(sphere);
+  ClothDef cloth;
+  cloth.nx = cloth.ny = 21;
+  cloth.corners = GridCorners{ Vec3(-0.5, 0.5, 0.5), Vec3(0.5, 0.5, 0.5), Vec3(-0.5, -0.5, 0.5) };
+  cloth.mass = 0.2;
+  cloth.structural = { 2000.0, 0.5 };
+  cloth.shear = { 500.0, 0.5 };
+  scene.bodies.push_back(buildCloth("cloth", cloth));
+  scene.bodies[0].contact_radius = thickness;
+  World world = buildWorld(scene);
+  double closest = 1e9;
+  for (int n = 0; n < 720; ++n)  // 6 s
+  {
+    world.step();
+    closest = std::min(closest, world.state().position.colwise().norm().minCoeff());
+  }
+  EXPECT_GE(closest, radius + thickness - 1e-9);
+  // It rests: draped over the ball (its middle on top), nearly still.
+  const int middle = (cloth.ny / 2) * cloth.nx + cloth.nx / 2;
+  EXPECT_NEAR(world.state().position(2, middle), radius + thickness, 1e-3);
+  EXPECT_LT(world.state().velocity.colwise().norm().maxCoeff(), 0.05);
+  RecordProperty("max_speed_at_6s", std::to_string(world.state().velocity.colwise().norm().maxCoeff()));
+}
+
+}  // namespace
+}  // namespace soft_body_sim::test
