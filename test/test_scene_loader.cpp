@@ -230,7 +230,7 @@ const BadScene kBadScenes[] = {
   { "UnknownTopLevelKey", R"(frame: world
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
-    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, rate, physics, planes, bodies" } },
+    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, rate, physics, planes, colliders, bodies" } },
   { "UnknownPhysicsKey", R"(physics:
   dt: 0.01
   timestep: 0.01
@@ -790,7 +790,7 @@ bodies: []
   { "TopLevelIsAList", R"(- name: b
   type: custom
 )",
-    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, rate, physics, planes, bodies", "a list" } },
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, rate, physics, planes, colliders, bodies", "a list" } },
   { "TopLevelIsAScalar", R"(hello
 )",
     "bad.yaml:1: (top level)", { "must be a YAML mapping", "'hello'" } },
@@ -1009,6 +1009,76 @@ bodies:
   // The model holds the colliders as declared; the contact stage normalises its own copy (test_world's
   // bounce on a plane of normal (0, 0, 3)).
   EXPECT_EQ(world.model().colliders.planes[0].normal, Vec3(0, 0, 2));
+}
+
+TEST(SceneLoader, CollidersAndContactRadiiAreRead)
+{
+  const SceneDef scene = parseScene(R"(colliders:
+  - name: table
+    shape: box
+    size: [1.0, 0.6, 0.05]
+    position: [0.0, 0.0, 0.7]
+    orientation: [0, 0, 1, 1]
+    friction: 0.5
+    restitution: 0.25
+  - {name: ball, shape: sphere, radius: 0.2, position: [1, 0, 0.5]}
+  - name: rod
+    shape: capsule
+    radius: 0.01
+    length: 0.5
+    velocity: [0.5, 0, 0]
+    angular_velocity: [0, 0, 2]
+bodies:
+  - {name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 10, radius: 0.005}
+  - {name: c, type: cloth, nx: 2, ny: 2, top_left: [0, 0, 1], top_right: [1, 0, 1], bottom_left: [0, 1, 1],
+     mass: 1, structural: {stiffness: 10}, shear: {stiffness: 10}, thickness: 0.002}
+)",
+                                    "colliders.yaml");
+  ASSERT_EQ(scene.colliders.boxes.size(), 1u);
+  const Box& table = scene.colliders.boxes[0];
+  EXPECT_EQ(table.at.name, "table");
+  expectVec3(table.size, 1.0, 0.6, 0.05);
+  expectVec3(table.at.position, 0.0, 0.0, 0.7);
+  // [x y z w] = [0 0 1 1], normalised: a quarter turn about z.
+  EXPECT_NEAR(table.at.orientation.z(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(table.at.orientation.w(), std::sqrt(0.5), 1e-15);
+  EXPECT_EQ(table.at.friction, 0.5);
+  EXPECT_EQ(table.at.restitution, 0.25);
+  ASSERT_EQ(scene.colliders.spheres.size(), 1u);
+  EXPECT_EQ(scene.colliders.spheres[0].radius, 0.2);
+  EXPECT_EQ(scene.colliders.spheres[0].at.friction, 0.0);
+  ASSERT_EQ(scene.colliders.capsules.size(), 1u);
+  EXPECT_EQ(scene.colliders.capsules[0].length, 0.5);
+  expectVec3(scene.colliders.capsules[0].at.velocity, 0.5, 0, 0);
+  expectVec3(scene.colliders.capsules[0].at.angular_velocity, 0, 0, 2);
+  EXPECT_EQ(scene.bodies[0].contact_radius, 0.005);
+  EXPECT_EQ(scene.bodies[1].contact_radius, 0.002);
+  const World world = buildWorld(scene);
+  EXPECT_EQ(world.model().contact_radius[0], 0.005);
+  EXPECT_EQ(world.model().contact_radius[3], 0.002);
+  ASSERT_EQ(world.colliderPoses().size(), 3u);
+}
+
+TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
+{
+  const std::string body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";
+  expectSceneError("colliders: [{name: a, shape: cone, radius: 1}]\n" + body, "bad.yaml:1: colliders[0].shape",
+                   { "unknown shape 'cone'", "sphere, capsule, box" });
+  expectSceneError("colliders: [{name: a, shape: sphere, radius: 0}]\n" + body, "bad.yaml:1: colliders[0].radius",
+                   { "> 0" });
+  expectSceneError("colliders: [{name: a, shape: box, size: [1, 0, 1]}]\n" + body, "bad.yaml:1: colliders[0].size",
+                   { "> 0" });
+  expectSceneError("colliders: [{name: a, shape: sphere, radius: 1, orientation: [0, 0, 0, 0]}]\n" + body,
+                   "bad.yaml:1: colliders[0].orientation", { "zero quaternion" });
+  expectSceneError("colliders: [{name: a, shape: sphere, radius: 1, friction: -1}]\n" + body,
+                   "bad.yaml:1: colliders[0].friction", { ">= 0" });
+  expectSceneError("colliders: [{name: a, shape: capsule, radius: 1}]\n" + body, "bad.yaml:1: colliders[0].length",
+                   { "missing required key" });
+  expectSceneError("colliders: [{name: a, shape: sphere, radius: 1}, {name: a, shape: sphere, radius: 2}]\n" + body,
+                   "bad.yaml:1: colliders[1].name", { "duplicate collider name 'a'" });
+  expectSceneError("bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1, "
+                   "radius: -0.1}]\n",
+                   "bad.yaml:1: bodies[0].radius", { "radius must be >= 0", "-0.1" });
 }
 
 // --- files -------------------------------------------------------------------------------------

@@ -17,13 +17,24 @@ namespace
 {
 using namespace scene_yaml;
 
-const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "bodies" };
+const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "colliders", "bodies" };
 const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag", "guard" };
 const Keys kGuardKeys = { "policy", "max_speed" };
 const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
 const Keys kAnchorKeys = { "name", "node", "frame" };
+const Keys kPlacementKeys = { "name",     "shape",    "position",         "orientation",
+                              "velocity", "friction", "angular_velocity", "restitution" };
 
 // --- scene parts -------------------------------------------------------------------------------
+
+/// A number in [0, 1].
+double readFraction(const Context& ctx, const Field& field)
+{
+  const double value = readNonNegative(ctx, field);
+  if (value > 1.0)
+    ctx.fail(field, "must be in [0, 1], got " + field.node.Scalar());
+  return value;
+}
 
 IntegratorType readIntegrator(const Context& ctx, const Field& field)
 {
@@ -86,14 +97,84 @@ Plane readPlane(const Context& ctx, const Field& field)
   if (!(plane.normal.norm() > 1e-12))
     ctx.fail(normal, "must not be the zero vector");
   if (const std::optional<Field> value = optionalKey(field, "restitution"))
-  {
-    plane.restitution = readNonNegative(ctx, *value);
-    if (plane.restitution > 1.0)
-      ctx.fail(*value, "must be in [0, 1], got " + value->node.Scalar());
-  }
+    plane.restitution = readFraction(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "friction"))
     plane.friction = readNonNegative(ctx, *value);
   return plane;
+}
+
+/// The keys every collider shape has: name, pose, motion and surface.
+ColliderPlacement readPlacement(const Context& ctx, const Field& field)
+{
+  ColliderPlacement at;
+  at.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
+  if (const std::optional<Field> value = optionalKey(field, "position"))
+    at.position = readVec3(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "orientation"))
+  {
+    const std::vector<Field> q = requireListOfSize(ctx, *value, 4, "numbers (a quaternion x, y, z, w)");
+    at.orientation = Eigen::Quaterniond(readNumber(ctx, q[3]), readNumber(ctx, q[0]), readNumber(ctx, q[1]),
+                                        readNumber(ctx, q[2]));
+    if (!(at.orientation.norm() > 1e-12))
+      ctx.fail(*value, "must not be the zero quaternion");
+    at.orientation.normalize();
+  }
+  if (const std::optional<Field> value = optionalKey(field, "velocity"))
+    at.velocity = readVec3(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "angular_velocity"))
+    at.angular_velocity = readVec3(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "friction"))
+    at.friction = readNonNegative(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "restitution"))
+    at.restitution = readFraction(ctx, *value);
+  return at;
+}
+
+Keys withPlacementKeys(const Keys& own)
+{
+  Keys keys = kPlacementKeys;
+  keys.insert(keys.end(), own.begin(), own.end());
+  return keys;
+}
+
+/// One item of `colliders:`, added to `colliders` by its shape.
+void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
+{
+  requireMapping(ctx, field);
+  const Field shape = requiredKey(ctx, field, "shape");
+  const std::string name = readNonEmptyString(ctx, shape);
+  if (name == "sphere")
+  {
+    requireMap(ctx, field, withPlacementKeys({ "radius" }));
+    Sphere sphere;
+    sphere.at = readPlacement(ctx, field);
+    sphere.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
+    colliders.spheres.push_back(sphere);
+  }
+  else if (name == "capsule")
+  {
+    requireMap(ctx, field, withPlacementKeys({ "radius", "length" }));
+    Capsule capsule;
+    capsule.at = readPlacement(ctx, field);
+    capsule.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
+    capsule.length = readNonNegative(ctx, requiredKey(ctx, field, "length"));
+    colliders.capsules.push_back(capsule);
+  }
+  else if (name == "box")
+  {
+    requireMap(ctx, field, withPlacementKeys({ "size" }));
+    Box box;
+    box.at = readPlacement(ctx, field);
+    const Field size = requiredKey(ctx, field, "size");
+    box.size = readVec3(ctx, size);
+    if (!(box.size.minCoeff() > 0.0))
+      ctx.fail(size, "every extent must be > 0");
+    colliders.boxes.push_back(box);
+  }
+  else
+  {
+    ctx.fail(shape, "unknown shape " + quoted(name) + "; valid shapes: sphere, capsule, box");
+  }
 }
 
 /// `anchors: [{name, node}]`, read after the body's type has expanded it, since `node` indexes the
@@ -159,6 +240,19 @@ SceneDef readScene(const Context& ctx, const Field& root)
   if (const std::optional<Field> planes = optionalKey(root, "planes"))
     for (const Field& item : requireList(ctx, *planes))
       scene.colliders.planes.push_back(readPlane(ctx, item));
+  if (const std::optional<Field> colliders = optionalKey(root, "colliders"))
+  {
+    std::map<std::string, std::string> path_by_name;  // to name the first collider in a duplicate error
+    for (const Field& item : requireList(ctx, *colliders))
+    {
+      readCollider(ctx, item, scene.colliders);
+      const std::string name = readNonEmptyString(ctx, requiredKey(ctx, item, "name"));
+      const auto [first, inserted] = path_by_name.emplace(name, item.path);
+      if (!inserted)
+        ctx.fail(requiredKey(ctx, item, "name"), "duplicate collider name " + quoted(name) + " (first used by " +
+                                                     first->second + ")");
+    }
+  }
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error

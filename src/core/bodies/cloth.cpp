@@ -86,9 +86,11 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   requireSprings(what, "shear", cloth.shear);
   if (cloth.bending)
     requireSprings(what, "bending", *cloth.bending);
+  requireDefinition(cloth.thickness >= 0.0, what, { "thickness" }, "thickness must be >= 0");
   BodyDef body;
   body.name = name;
   body.type = "cloth";
+  body.contact_radius = cloth.thickness;
   const int nx = cloth.nx;
   const int ny = cloth.ny;
   addSpringGrid(body, cloth.corners, nx, ny, cloth.mass, cloth.structural, cloth.shear);

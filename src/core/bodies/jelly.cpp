@@ -14,9 +14,11 @@ BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
   requireSprings(what, "edges", jelly.edges);
   requireSprings(what, "diagonals", jelly.diagonals);
   requireDefinition(jelly.pressure > 0.0, what, { "pressure" }, "pressure must be > 0");
+  requireDefinition(jelly.thickness >= 0.0, what, { "thickness" }, "thickness must be >= 0");
   BodyDef body;
   body.name = name;
   body.type = "jelly";
+  body.contact_radius = jelly.thickness;
   const int columns = jelly.nx + 1;
   addSpringGrid(body, jelly.corners, columns, jelly.ny + 1, jelly.mass, jelly.edges, jelly.diagonals);
   // One gas cell per square, its nodes right along the top edge, then down the left edge: counter-

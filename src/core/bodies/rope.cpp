@@ -15,11 +15,13 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
   requireDefinition(rope.bending_damping >= 0.0, what, { "bending_damping" }, "bending_damping must be >= 0");
   requireDefinition(rope.bending_damping == 0.0 || rope.bending > 0.0, what, { "bending_damping" },
                     "bending_damping has no effect without bending > 0 (there are no bending springs to damp)");
+  requireDefinition(rope.radius >= 0.0, what, { "radius" }, "radius must be >= 0");
   requireDefinition((rope.to - rope.from).norm() > 0.0, what, { "to", "from" },
                     "to must differ from 'from'; a rope needs a length");
   BodyDef body;
   body.name = name;
   body.type = "rope";
+  body.contact_radius = rope.radius;
   const double node_mass = rope.mass / rope.nodes;
   for (int i = 0; i < rope.nodes; ++i)
   {

@@ -6,7 +6,7 @@ namespace soft_body_sim::scene_yaml
 BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass",
-                                              "structural", "shear", "bending", "pinned" }));
+                                              "structural", "shear", "bending", "pinned", "thickness" }));
   ClothDef cloth;
   cloth.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 2);
   const Field ny = requiredKey(ctx, field, "ny");
@@ -21,6 +21,8 @@ BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& 
     cloth.bending = readSpringParameters(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "pinned"))
     cloth.pinned = readPinned(ctx, *value, cloth.nx * cloth.ny, cloth.nx, cloth.ny);
+  if (const std::optional<Field> value = optionalKey(field, "thickness"))
+    cloth.thickness = readNumber(ctx, *value);
   return buildBody(ctx, field, cloth, buildCloth);
 }
 

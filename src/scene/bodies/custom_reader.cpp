@@ -61,7 +61,7 @@ ConstraintDef readConstraint(const Context& ctx, const Field& field, std::size_t
 
 BodyDef readCustomBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
-  requireMap(ctx, field, withCommonBodyKeys({ "nodes", "springs", "constraints" }));
+  requireMap(ctx, field, withCommonBodyKeys({ "nodes", "springs", "constraints", "radius" }));
   BodyDef body;  // a custom body is its own definition: BodyDef's type is "custom"
   body.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
   const Field nodes = requiredKey(ctx, field, "nodes");
@@ -77,6 +77,8 @@ BodyDef readCustomBody(const Context& ctx, const Field& field, const SceneSoFar&
   if (const std::optional<Field> constraints = optionalKey(field, "constraints"))
     for (const Field& item : requireList(ctx, *constraints))
       body.constraints.push_back(readConstraint(ctx, item, body.nodes.size()));
+  if (const std::optional<Field> value = optionalKey(field, "radius"))
+    body.contact_radius = readNonNegative(ctx, *value);
   return body;
 }
 

@@ -7,7 +7,7 @@ namespace soft_body_sim::scene_yaml
 BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass", "edges",
-                                              "diagonals", "pressure" }));
+                                              "diagonals", "pressure", "thickness" }));
   JellyDef jelly;
   jelly.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 1);
   const Field ny = requiredKey(ctx, field, "ny");
@@ -19,6 +19,8 @@ BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& 
   jelly.edges = readSpringParameters(ctx, requiredKey(ctx, field, "edges"));
   jelly.diagonals = readSpringParameters(ctx, requiredKey(ctx, field, "diagonals"));
   jelly.pressure = readNumber(ctx, requiredKey(ctx, field, "pressure"));
+  if (const std::optional<Field> value = optionalKey(field, "thickness"))
+    jelly.thickness = readNumber(ctx, *value);
   return buildBody(ctx, field, jelly, buildJelly);
 }
 

@@ -7,7 +7,7 @@ namespace soft_body_sim::scene_yaml
 BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nodes", "from", "to", "mass", "stiffness", "damping", "bending",
-                                              "bending_damping", "pinned" }));
+                                              "bending_damping", "pinned", "radius" }));
   RopeDef rope;
   const Field nodes = requiredKey(ctx, field, "nodes");
   rope.nodes = readCount(ctx, nodes, 2);
@@ -27,6 +27,8 @@ BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& s
     rope.bending_damping = readNumber(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "pinned"))
     rope.pinned = readPinned(ctx, *value, rope.nodes);
+  if (const std::optional<Field> value = optionalKey(field, "radius"))
+    rope.radius = readNumber(ctx, *value);
   return buildBody(ctx, field, rope, buildRope);
 }
 

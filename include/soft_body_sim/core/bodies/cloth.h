@@ -55,6 +55,7 @@ struct ClothDef
   SpringParameters shear{ 50.0, 0.05 };                  ///< springs across each square's 2 diagonals
   std::optional<SpringParameters> bending;               ///< springs to second neighbours; none by default
   std::vector<int> pinned;                               ///< pinned node indices; negative counts from the end
+  double thickness = 0.0;                                ///< [m] >= 0: contact radius of its nodes
 };
 
 /// Appends to `body` a grid of columns x rows nodes of equal mass (mass / (columns rows) [kg]) spanning

@@ -34,6 +34,7 @@ struct JellyDef
   SpringParameters edges{ 2000.0, 1.0 };                     ///< springs along the cells' edges
   SpringParameters diagonals{ 1000.0, 0.5 };                 ///< springs along both diagonals of each cell
   double pressure = 1000.0;                                  ///< each cell's rest gas pressure p0 [N/m], > 0
+  double thickness = 0.0;                                    ///< [m] >= 0: contact radius of its nodes
 };
 
 /// The jelly as nodes, springs and pressure cells (type "jelly"). Each cell's corners run

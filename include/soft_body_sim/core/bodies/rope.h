@@ -20,6 +20,7 @@ struct RopeDef
   double bending = 0.0;               ///< stiffness [N/m] of springs to second neighbours; 0 = none
   double bending_damping = 0.0;       ///< their dashpot [N s/m]
   std::vector<int> pinned;            ///< pinned node indices; negative counts from the end (-1 = last)
+  double radius = 0.0;                ///< [m] >= 0: contact radius of its nodes (0 = points)
 };
 
 /// The rope as nodes and springs (type "rope"); throws std::invalid_argument on a bad definition.
