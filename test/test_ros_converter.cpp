@@ -1,6 +1,7 @@
 // Message conversions as plain structs (no ROS master): markers, state, poses and reconfigure configs.
 #include <cmath>
 #include <limits>
+#include <set>
 
 #include <gtest/gtest.h>
 
@@ -102,6 +103,56 @@ TEST(RosConverter, StateSaysWhatTheDivergenceGuardDidToEachBody)
   EXPECT_EQ(state.bodies[1].integrator, "implicit_euler");
   EXPECT_EQ(state.bodies[1].divergence_events, 1u);
   EXPECT_FALSE(state.bodies[1].frozen);
+}
+
+TEST(RosConverter, CollidersAreDrawnInTheirCurrentPoseWithTheirExtents)
+{
+  SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 0.5);
+  scene.bodies[0].nodes = { NodeDef{ Vec3(5, 5, 5), 1.0 } };
+  Sphere ball;
+  ball.at.name = "ball";
+  ball.radius = 0.2;
+  ball.at.position = Vec3(1, 0, 0);
+  Capsule rod;
+  rod.at.name = "rod";
+  rod.radius = 0.01;
+  rod.length = 0.5;
+  rod.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitY()));  // along x
+  rod.at.velocity = Vec3(0, 2, 0);
+  Box table;
+  table.at.name = "table";
+  table.size = Vec3(1.0, 0.6, 0.05);
+  scene.colliders = Colliders{ {}, { ball }, { rod }, { table } };
+  World world = buildWorld(scene);
+  world.step();  // the rod moves by 2 m/s x 0.5 s
+  const visualization_msgs::MarkerArray markers = RosConverter::toMarkers(world, "world", ros::Time(3.0));
+  std::vector<visualization_msgs::Marker> drawn;
+  for (const visualization_msgs::Marker& m : markers.markers)
+    if (m.ns == "colliders")
+      drawn.push_back(m);
+  ASSERT_EQ(drawn.size(), 5u);  // sphere, cylinder + 2 caps, cube
+  EXPECT_EQ(drawn[0].type, visualization_msgs::Marker::SPHERE);
+  EXPECT_EQ(drawn[0].scale.x, 0.4);
+  EXPECT_EQ(drawn[0].pose.position.x, 1.0);
+  EXPECT_EQ(drawn[1].type, visualization_msgs::Marker::CYLINDER);
+  EXPECT_EQ(drawn[1].scale.z, 0.5);
+  EXPECT_EQ(drawn[1].scale.x, 0.02);
+  EXPECT_NEAR(drawn[1].pose.position.y, 1.0, 1e-12);
+  EXPECT_NEAR(drawn[1].pose.orientation.y, std::sqrt(0.5), 1e-12);
+  // The caps sit at the ends of the rod's axis, which points along x.
+  EXPECT_EQ(drawn[2].type, visualization_msgs::Marker::SPHERE);
+  EXPECT_NEAR(std::abs(drawn[2].pose.position.x), 0.25, 1e-12);
+  EXPECT_NEAR(drawn[2].pose.position.x, -drawn[3].pose.position.x, 1e-12);
+  EXPECT_EQ(drawn[4].type, visualization_msgs::Marker::CUBE);
+  EXPECT_EQ(drawn[4].scale.y, 0.6);
+  std::set<int> ids;
+  for (const visualization_msgs::Marker& m : drawn)
+  {
+    EXPECT_EQ(m.header.frame_id, "world");
+    EXPECT_EQ(m.action, visualization_msgs::Marker::ADD);
+    ids.insert(m.id);
+  }
+  EXPECT_EQ(ids.size(), drawn.size());
 }
 
 TEST(RosConverter, AMarkerWithoutPointsIsSentAsDelete)

@@ -49,6 +49,60 @@ geometry_msgs::Point point(const Vec3& p)
   return out;
 }
 
+/// A grey solid for the colliders, a little transparent so that a body behind one stays visible.
+std_msgs::ColorRGBA colliderColor()
+{
+  std_msgs::ColorRGBA color;
+  color.r = color.g = color.b = 0.6f;
+  color.a = 0.8f;
+  return color;
+}
+
+geometry_msgs::Pose pose(const Vec3& position, const Eigen::Quaterniond& orientation)
+{
+  geometry_msgs::Pose out;
+  out.position = point(position);
+  out.orientation.x = orientation.x();
+  out.orientation.y = orientation.y();
+  out.orientation.z = orientation.z();
+  out.orientation.w = orientation.w();
+  return out;
+}
+
+/// Namespace "colliders": per collider k, id 3k its solid (SPHERE, CYLINDER or CUBE in its pose); a
+/// capsule adds its two end caps as SPHEREs, ids 3k + 1 and 3k + 2.
+void addColliderMarkers(const World& world, const std::string& frame_id, const ros::Time& stamp,
+                        visualization_msgs::MarkerArray& array)
+{
+  const std::vector<ColliderPose> poses = world.colliderPoses();
+  for (std::size_t k = 0; k < poses.size(); ++k)
+  {
+    const ColliderPose& c = poses[k];
+    const int id = 3 * static_cast<int>(k);
+    int type = visualization_msgs::Marker::SPHERE;
+    if (c.shape == ColliderPose::Shape::Capsule)
+      type = visualization_msgs::Marker::CYLINDER;
+    else if (c.shape == ColliderPose::Shape::Box)
+      type = visualization_msgs::Marker::CUBE;
+    visualization_msgs::Marker solid = marker(frame_id, stamp, "colliders", id, type, 1.0, colliderColor());
+    solid.pose = pose(c.position, c.orientation);
+    solid.scale.x = c.size.x();
+    solid.scale.y = c.size.y();
+    solid.scale.z = c.size.z();
+    array.markers.push_back(solid);
+    if (c.shape != ColliderPose::Shape::Capsule)
+      continue;
+    for (const int end : { 1, 2 })
+    {
+      const Vec3 axis = c.orientation * Vec3(0.0, 0.0, (end == 1 ? 0.5 : -0.5) * c.size.z());
+      visualization_msgs::Marker cap = marker(frame_id, stamp, "colliders", id + end,
+                                              visualization_msgs::Marker::SPHERE, c.size.x(), colliderColor());
+      cap.pose = pose(c.position + axis, c.orientation);
+      array.markers.push_back(cap);
+    }
+  }
+}
+
 /// A line from node a to node b if both ends are finite.
 void addSegment(const NodeArray& x, int a, int b, visualization_msgs::Marker& lines)
 {
@@ -108,6 +162,7 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
       array.markers.push_back(strip);
     }
   }
+  addColliderMarkers(world, frame_id, stamp, array);
   return array;
 }
 

@@ -29,7 +29,9 @@ class RosConverter
 {
 public:
   /// One namespace per body (its name): id 0 a SPHERE_LIST of its nodes in node order, id 1 a
-  /// LINE_LIST of its springs and constraints, ids 2.. a LINE_STRIP per curve of its controller (limbs).
+  /// LINE_LIST of its springs and constraints, ids 2.. a LINE_STRIP per curve of its controller (limbs);
+  /// and namespace "colliders": each sphere, capsule and box in its current pose (a capsule as a
+  /// CYLINDER with two SPHERE caps).
   /// Non-finite positions are never published: such a node is left out of the markers. A marker
   /// without points (a body without springs) is sent with action DELETE.
   static visualization_msgs::MarkerArray toMarkers(const World& world, const std::string& frame_id,
