@@ -4,6 +4,7 @@
 // outside it by its thickness.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 #include <string>
 #include <vector>
@@ -222,6 +223,42 @@ TEST(ColliderFriction, AMovingBoxDragsARestingNodeUpToItsOwnSpeed)
     EXPECT_NEAR(world.state().velocity(0, 0), speed, 1e-9);
     EXPECT_NEAR(world.state().position(2, 0), 0.1, 1e-9);
   }
+}
+
+// A collider that follows a path (as a tf frame drives it) lands on the path at every step's end and moves
+// at the path's velocity in between, which friction sees: the conveyor above, driven by a path instead of
+// a declared velocity, drags the node the same way, and a turning path's orientation is met exactly.
+TEST(ColliderPath, APathDrivenColliderLandsOnItsPathAndDragsByItsVelocity)
+{
+  const double mu = 0.4, speed = 0.5, dt = 1.0 / 240.0;
+  SceneDef scene = nodeOnTiltedBox(IntegratorType::SemiImplicitEuler, 0.0, mu, dt);
+  Capsule marker;
+  marker.at.name = "marker";
+  marker.at.position = Vec3(0, 0, 5);
+  marker.radius = 0.01;
+  marker.length = 0.1;
+  scene.colliders.capsules.push_back(marker);
+  World world = buildWorld(scene);
+  ASSERT_TRUE(world.followColliderPath("ramp", [speed](double t) {
+    return std::optional<RigidPose>(RigidPose{ Vec3(speed * t, 0, 0), Eigen::Quaterniond::Identity() });
+  }));
+  ASSERT_TRUE(world.followColliderPath("marker", [](double t) {
+    return std::optional<RigidPose>(
+        RigidPose{ Vec3(0, 0, 5), Eigen::Quaterniond(Eigen::AngleAxisd(2.0 * t, Vec3::UnitZ())) });
+  }));
+  EXPECT_FALSE(world.followColliderPath("nothing", [](double) { return std::optional<RigidPose>(); }));
+  for (int n = 0; n < 24; ++n)
+    world.step();
+  EXPECT_NEAR(world.state().velocity(0, 0), mu * kGravity * 24 * dt, 0.02 * mu * kGravity * 24 * dt);
+  for (int n = 0; n < 96; ++n)
+    world.step();
+  EXPECT_NEAR(world.state().velocity(0, 0), speed, 1e-9);
+  const std::vector<ColliderPose> poses = world.colliderPoses();
+  ASSERT_EQ(poses.size(), 2u);
+  EXPECT_EQ(poses[0].name, "marker");  // capsules before boxes
+  EXPECT_NEAR(poses[1].position.x(), speed * world.time(), 1e-12);
+  const Eigen::Quaterniond expected(Eigen::AngleAxisd(2.0 * world.time(), Vec3::UnitZ()));
+  EXPECT_NEAR(poses[0].orientation.angularDistance(expected), 0.0, 1e-9);
 }
 
 // --- a cloth onto a sphere -------------------------------------------------------------------------------

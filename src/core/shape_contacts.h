@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <vector>
 
@@ -20,7 +21,7 @@ class ShapeContacts final : public ColliderKind
 {
 public:
   ShapeContacts(std::vector<Shape> shapes, int nodes)
-    : shapes_(std::move(shapes)), touching_(static_cast<std::size_t>(nodes), 0)
+    : shapes_(std::move(shapes)), goals_(shapes_.size()), touching_(static_cast<std::size_t>(nodes), 0)
   {
     for (Shape& shape : shapes_)
       preparePlacement(shape.at);
@@ -67,16 +68,42 @@ public:
       poses.push_back(ColliderPose::of(shape));
   }
 
-  bool setPose(const std::string& name, const Vec3& position, const Eigen::Quaterniond& orientation) override
+  bool setGoal(const std::string& name, const std::optional<RigidPose>& goal, double dt) override
   {
-    for (Shape& shape : shapes_)
-      if (shape.at.name == name)
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      ColliderPlacement& at = shapes_[k].at;
+      if (at.name != name)
+        continue;
+      goals_[k] = goal;
+      if (!goal)
       {
-        shape.at.position = position;
-        shape.at.orientation = orientation.normalized();
+        at.velocity.setZero();
+        at.angular_velocity.setZero();
         return true;
       }
+      goals_[k]->orientation.normalize();
+      at.velocity = (goal->position - at.position) / dt;
+      // The turn from the current orientation to the goal's, as a rotation vector over dt (the shorter way).
+      Eigen::Quaterniond turn = goals_[k]->orientation * at.orientation.conjugate();
+      if (turn.w() < 0.0)
+        turn.coeffs() = -turn.coeffs();
+      const Eigen::AngleAxisd axis_angle(turn);
+      at.angular_velocity = axis_angle.angle() / dt * axis_angle.axis();
+      return true;
+    }
     return false;
+  }
+
+  void land() override
+  {
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+      if (goals_[k])
+      {
+        shapes_[k].at.position = goals_[k]->position;
+        shapes_[k].at.orientation = goals_[k]->orientation;
+        goals_[k].reset();
+      }
   }
 
 private:
@@ -95,6 +122,7 @@ private:
   }
 
   std::vector<Shape> shapes_;
+  std::vector<std::optional<RigidPose>> goals_;  ///< per shape: where it arrives at this step's end
   std::vector<std::uint8_t> touching_;  ///< per node: on one of these shapes after the last sub-step
 };
 

@@ -41,6 +41,7 @@ void World::step()
   const double h = dt / settings_.substeps;
   integrators_.prepare(model_);
   anchors_.goalsFromPaths(time() + dt);
+  contacts_.goalsFromPaths(time() + dt, dt);
   const bool kinematic = driveKinematicNodes(dt);
   for (int substep = 0; substep < settings_.substeps; ++substep)
   {
@@ -49,7 +50,7 @@ void World::step()
     integrate(h);
     resolveContacts(h);
   }
-  landAnchors();
+  landKinematics();
   ++steps_;
   guardBodies();
 }
@@ -83,7 +84,11 @@ void World::resolveContacts(double h)
     integrators_.invalidate();
 }
 
-void World::landAnchors() { anchors_.land(model_, state_); }
+void World::landKinematics()
+{
+  anchors_.land(model_, state_);
+  contacts_.land();
+}
 
 void World::guardBodies()
 {

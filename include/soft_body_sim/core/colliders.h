@@ -67,6 +67,20 @@ struct Colliders
   std::vector<Box> boxes;
 };
 
+/// Every shape's placement, in the order of Colliders' vectors (spheres, capsules, boxes): for the
+/// callers that treat all shapes alike (which follow a tf frame).
+inline std::vector<const ColliderPlacement*> placements(const Colliders& colliders)
+{
+  std::vector<const ColliderPlacement*> all;
+  for (const Sphere& s : colliders.spheres)
+    all.push_back(&s.at);
+  for (const Capsule& c : colliders.capsules)
+    all.push_back(&c.at);
+  for (const Box& b : colliders.boxes)
+    all.push_back(&b.at);
+  return all;
+}
+
 /// The nearest point of a shape's surface to a point, in the shape's local frame.
 struct SurfaceDistance
 {

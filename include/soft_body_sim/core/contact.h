@@ -6,7 +6,9 @@
 // has no kinds here and pays nothing.
 #pragma once
 
+#include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -38,6 +40,16 @@ struct ColliderPose
   static ColliderPose of(const Box& b) { return { b.at.name, Shape::Box, b.at.position, b.at.orientation, b.size }; }
 };
 
+/// A rigid pose: position [m] and orientation (unit quaternion) of a collider's origin and axes.
+struct RigidPose
+{
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+};
+
+/// Where a collider should be at simulated time t [s]; nullopt = not known (it then holds still).
+using ColliderPath = std::function<std::optional<RigidPose>(double t)>;
+
 /// One kind of collider, over all of its shapes in the model.
 class ColliderKind
 {
@@ -49,11 +61,14 @@ public:
   virtual bool resolve(const Model& model, const NodeArray& start, State& state, double h) = 0;
   /// Appends the current pose of each of its drawable shapes (planes are infinite: none).
   virtual void appendPoses(std::vector<ColliderPose>& /*poses*/) const {}
-  /// Places its shape `name` (a unit quaternion); false if it has none of that name.
-  virtual bool setPose(const std::string& /*name*/, const Vec3& /*position*/, const Eigen::Quaterniond& /*orientation*/)
+  /// Moves its shape `name` to `goal` over the next dt [s] at constant linear and angular velocity (its
+  /// velocities for friction); nullopt: it holds still. False if it has no shape of that name.
+  virtual bool setGoal(const std::string& /*name*/, const std::optional<RigidPose>& /*goal*/, double /*dt*/)
   {
     return false;
   }
+  /// At a step's end: the shapes that had a goal sit exactly on it.
+  virtual void land() {}
 };
 
 /// The kinds of collider that `model` declares, in the order they resolve. Throws std::invalid_argument
@@ -91,18 +106,43 @@ public:
     return poses;
   }
 
-  /// Places collider `name`; false if there is none of that name.
-  bool setPose(const std::string& name, const Vec3& position, const Eigen::Quaterniond& orientation)
+  /// Moves collider `name` to `goal` over the next dt [s]; false if there is none of that name.
+  bool setGoal(const std::string& name, const std::optional<RigidPose>& goal, double dt)
   {
     for (const std::unique_ptr<ColliderKind>& kind : kinds_)
-      if (kind->setPose(name, position, orientation))
+      if (kind->setGoal(name, goal, dt))
         return true;
     return false;
+  }
+
+  /// Collider `name` follows `path` from the next step on (setGoal to path(t) at every step's end time
+  /// t); false if there is none of that name.
+  bool followPath(const std::string& name, ColliderPath path)
+  {
+    if (!setGoal(name, std::nullopt, 1.0))
+      return false;
+    paths_.emplace_back(name, std::move(path));
+    return true;
+  }
+
+  /// At a step's start: every collider with a path heads for where it will be at `end_time` [s].
+  void goalsFromPaths(double end_time, double dt)
+  {
+    for (const auto& [name, path] : paths_)
+      setGoal(name, path(end_time), dt);
+  }
+
+  /// At a step's end: every collider that had a goal sits on it.
+  void land()
+  {
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      kind->land();
   }
 
 private:
   std::vector<std::unique_ptr<ColliderKind>> kinds_;
   NodeArray start_;  ///< positions before the current sub-step's integration [m]
+  std::vector<std::pair<std::string, ColliderPath>> paths_;
 };
 
 }  // namespace soft_body_sim

@@ -75,12 +75,12 @@ public:
 
   /// The current pose of every drawable collider (spheres, capsules, boxes), in declaration order by kind.
   std::vector<ColliderPose> colliderPoses() const { return contacts_.poses(); }
-  /// Places collider `name` at `position` [m] with `orientation` (normalised here) from the next
-  /// sub-step on; false if there is none of that name.
-  bool moveCollider(const std::string& name, const Vec3& position, const Eigen::Quaterniond& orientation)
-  {
-    return contacts_.setPose(name, position, orientation);
-  }
+  /// Moves collider `name` to `pose` during the next step at constant linear and angular velocity (which
+  /// friction sees), as moveAnchor; false if there is none of that name. The latest call before a step wins.
+  bool moveCollider(const std::string& name, const RigidPose& pose) { return contacts_.setGoal(name, pose, settings_.dt); }
+  /// Every step, collider `name` moves (as by moveCollider) to path(t) at the step's end time t; where the
+  /// path has no pose it holds still. False if there is none of that name.
+  bool followColliderPath(const std::string& name, ColliderPath path) { return contacts_.followPath(name, std::move(path)); }
 
   /// Sets a node's position [m] and velocity [m/s] directly.
   void setNode(int node, const Vec3& position, const Vec3& velocity);
@@ -144,8 +144,8 @@ private:
   void moveAnchors(double h);
   void integrate(double h);
   void resolveContacts(double h);
-  /// Anchors land on their goals.
-  void landAnchors();
+  /// Anchors and path-driven colliders land on their goals.
+  void landKinematics();
   /// Checks every body, restores and treats the diverged ones, keeps the good state.
   void guardBodies();
 
