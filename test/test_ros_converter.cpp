@@ -155,6 +155,23 @@ TEST(RosConverter, CollidersAreDrawnInTheirCurrentPoseWithTheirExtents)
   EXPECT_EQ(ids.size(), drawn.size());
 }
 
+TEST(RosConverter, ATransformIsARigidPoseUnlessNotFiniteOrWithoutRotation)
+{
+  geometry_msgs::Transform transform;
+  transform.translation.x = 1.0;
+  transform.translation.z = -2.0;
+  transform.rotation.z = 2.0;  // a half turn about z, not normalised
+  const std::optional<RigidPose> pose = RosConverter::toRigidPose(transform);
+  ASSERT_TRUE(pose);
+  EXPECT_EQ(pose->position, Vec3(1.0, 0.0, -2.0));
+  EXPECT_NEAR((pose->orientation * Vec3::UnitX() - Vec3(-1, 0, 0)).norm(), 0.0, 1e-15);
+  transform.rotation.z = 0.0;
+  EXPECT_FALSE(RosConverter::toRigidPose(transform));
+  transform.rotation.w = 1.0;
+  transform.translation.y = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(RosConverter::toRigidPose(transform));
+}
+
 TEST(RosConverter, AMarkerWithoutPointsIsSentAsDelete)
 {
   SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);

@@ -1028,6 +1028,7 @@ TEST(SceneLoader, CollidersAndContactRadiiAreRead)
     length: 0.5
     velocity: [0.5, 0, 0]
     angular_velocity: [0, 0, 2]
+  - {name: finger, shape: capsule, radius: 0.008, length: 0.06, frame: gripper_link}
 bodies:
   - {name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 10, radius: 0.005}
   - {name: c, type: cloth, nx: 2, ny: 2, top_left: [0, 0, 1], top_right: [1, 0, 1], bottom_left: [0, 1, 1],
@@ -1047,8 +1048,10 @@ bodies:
   ASSERT_EQ(scene.colliders.spheres.size(), 1u);
   EXPECT_EQ(scene.colliders.spheres[0].radius, 0.2);
   EXPECT_EQ(scene.colliders.spheres[0].at.friction, 0.0);
-  ASSERT_EQ(scene.colliders.capsules.size(), 1u);
+  ASSERT_EQ(scene.colliders.capsules.size(), 2u);
   EXPECT_EQ(scene.colliders.capsules[0].length, 0.5);
+  EXPECT_EQ(scene.colliders.capsules[0].at.frame, "");
+  EXPECT_EQ(scene.colliders.capsules[1].at.frame, "gripper_link");
   expectVec3(scene.colliders.capsules[0].at.velocity, 0.5, 0, 0);
   expectVec3(scene.colliders.capsules[0].at.angular_velocity, 0, 0, 2);
   EXPECT_EQ(scene.bodies[0].contact_radius, 0.005);
@@ -1056,7 +1059,7 @@ bodies:
   const World world = buildWorld(scene);
   EXPECT_EQ(world.model().contact_radius[0], 0.005);
   EXPECT_EQ(world.model().contact_radius[3], 0.002);
-  ASSERT_EQ(world.colliderPoses().size(), 3u);
+  ASSERT_EQ(world.colliderPoses().size(), 3u);  // the finger appears once tf knows its frame
 }
 
 TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
@@ -1074,6 +1077,10 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
                    "bad.yaml:1: colliders[0].friction", { ">= 0" });
   expectSceneError("colliders: [{name: a, shape: capsule, radius: 1}]\n" + body, "bad.yaml:1: colliders[0].length",
                    { "missing required key" });
+  expectSceneError("colliders: [{name: a, shape: sphere, radius: 1, frame: hand, velocity: [1, 0, 0]}]\n" + body,
+                   "bad.yaml:1: colliders[0].velocity", { "moves with its frame" });
+  expectSceneError("colliders: [{name: a, shape: sphere, radius: 1, frame: /hand}]\n" + body,
+                   "bad.yaml:1: colliders[0].frame", { "must not start with '/'" });
   expectSceneError("colliders: [{name: a, shape: sphere, radius: 1}, {name: a, shape: sphere, radius: 2}]\n" + body,
                    "bad.yaml:1: colliders[1].name", { "duplicate collider name 'a'" });
   expectSceneError("bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1, "

@@ -24,7 +24,11 @@ public:
     : shapes_(std::move(shapes)), goals_(shapes_.size()), touching_(static_cast<std::size_t>(nodes), 0)
   {
     for (Shape& shape : shapes_)
+    {
       preparePlacement(shape.at);
+      // A shape on a tf frame has no place in the scene until its frame's first pose lands.
+      placed_.push_back(shape.at.frame.empty() ? 1 : 0);
+    }
   }
 
   bool resolve(const Model& model, const NodeArray& start, State& state, double h) override
@@ -40,8 +44,11 @@ public:
       const bool was_touching = touching_[static_cast<std::size_t>(i)] != 0;
       bool touched = false;
       const double radius = model.contact_radius[i];
-      for (const Shape& shape : shapes_)
+      for (std::size_t k = 0; k < shapes_.size(); ++k)
       {
+        if (!placed_[k])
+          continue;
+        const Shape& shape = shapes_[k];
         const ColliderPlacement& at = shape.at;
         const Vec3 local = at.orientation.conjugate() * (Vec3(state.position.col(i)) - at.position);
         const SurfaceDistance surface = surfaceDistance(shape, local);
@@ -64,8 +71,9 @@ public:
 
   void appendPoses(std::vector<ColliderPose>& poses) const override
   {
-    for (const Shape& shape : shapes_)
-      poses.push_back(ColliderPose::of(shape));
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+      if (placed_[k])
+        poses.push_back(ColliderPose::of(shapes_[k]));
   }
 
   bool setGoal(const std::string& name, const std::optional<RigidPose>& goal, double dt) override
@@ -83,6 +91,15 @@ public:
         return true;
       }
       goals_[k]->orientation.normalize();
+      if (!placed_[k])
+      {
+        // Its first pose: it appears there, at rest.
+        at.position = goals_[k]->position;
+        at.orientation = goals_[k]->orientation;
+        at.velocity.setZero();
+        at.angular_velocity.setZero();
+        return true;
+      }
       at.velocity = (goal->position - at.position) / dt;
       // The turn from the current orientation to the goal's, as a rotation vector over dt (the shorter way).
       Eigen::Quaterniond turn = goals_[k]->orientation * at.orientation.conjugate();
@@ -103,6 +120,7 @@ public:
         shapes_[k].at.position = goals_[k]->position;
         shapes_[k].at.orientation = goals_[k]->orientation;
         goals_[k].reset();
+        placed_[k] = 1;
       }
   }
 
@@ -123,6 +141,7 @@ private:
 
   std::vector<Shape> shapes_;
   std::vector<std::optional<RigidPose>> goals_;  ///< per shape: where it arrives at this step's end
+  std::vector<char> placed_;                     ///< per shape: has a pose in the scene (collides, is drawn)
   std::vector<std::uint8_t> touching_;  ///< per node: on one of these shapes after the last sub-step
 };
 

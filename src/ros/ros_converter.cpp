@@ -225,6 +225,18 @@ bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position, std
   return true;
 }
 
+std::optional<RigidPose> RosConverter::toRigidPose(const geometry_msgs::Transform& transform)
+{
+  RigidPose pose;
+  pose.position = toVec3(transform.translation);
+  pose.orientation = Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y,
+                                        transform.rotation.z);
+  if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite() || !(pose.orientation.norm() > 1e-12))
+    return std::nullopt;
+  pose.orientation.normalize();
+  return pose;
+}
+
 SimConfig RosConverter::toSimConfig(const World& world)
 {
   SimConfig config = SimConfig::__getDefault__();

@@ -77,6 +77,9 @@ void SimNode::buildWorldFromScene()
   for (std::size_t k = 0; k < anchors.size(); ++k)
     if (!anchors[k].frame.empty())
       followFrame(static_cast<int>(k), anchors[k].frame);
+  for (const ColliderPlacement* at : placements(world_->model().colliders))
+    if (!at->frame.empty())
+      followFrame(*at);
   targets_.clear();
   inputs_.clear();
 }

@@ -235,7 +235,7 @@ bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::st
   return true;
 }
 
-std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Time& stamp)
+std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros::Time& stamp)
 {
   geometry_msgs::TransformStamped transform;
   try
@@ -255,16 +255,36 @@ std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Ti
                       scene_.frame_id.c_str(), e.what());
     return std::nullopt;
   }
-  const Vec3 origin = RosConverter::toVec3(transform.transform.translation);
-  if (!origin.allFinite())
-    return std::nullopt;
-  return origin;
+  const std::optional<RigidPose> pose = RosConverter::toRigidPose(transform.transform);
+  if (!pose)
+    ROS_WARN_THROTTLE(5.0, "%s: the transform from '%s' to '%s' is not finite or has a zero rotation", name_.c_str(),
+                      frame.c_str(), scene_.frame_id.c_str());
+  return pose;
+}
+
+std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Time& stamp)
+{
+  const std::optional<RigidPose> pose = framePose(frame, stamp);
+  return pose ? std::optional<Vec3>(pose->position) : std::nullopt;
 }
 
 void SimNode::followFrame(int anchor, const std::string& frame)
 {
   // The path is asked for the step's end: the frame's pose at that ROS time, interpolated by tf.
   world_->followPath(anchor, [this, frame](double t) { return frameOrigin(frame, rosTime(t)); });
+}
+
+void SimNode::followFrame(const ColliderPlacement& collider)
+{
+  // The scene's pose of the collider is relative to its frame.
+  const RigidPose local{ collider.position, collider.orientation };
+  const std::string frame = collider.frame;
+  world_->followColliderPath(collider.name, [this, frame, local](double t) -> std::optional<RigidPose> {
+    const std::optional<RigidPose> origin = framePose(frame, rosTime(t));
+    if (!origin)
+      return std::nullopt;
+    return RigidPose{ origin->position + origin->orientation * local.position, origin->orientation * local.orientation };
+  });
 }
 
 bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)

@@ -22,10 +22,19 @@ const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravi
 const Keys kGuardKeys = { "policy", "max_speed" };
 const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
 const Keys kAnchorKeys = { "name", "node", "frame" };
-const Keys kPlacementKeys = { "name",     "shape",    "position",         "orientation",
-                              "velocity", "friction", "angular_velocity", "restitution" };
+const Keys kPlacementKeys = { "name",     "shape",    "position",         "orientation", "velocity",
+                              "friction", "angular_velocity", "restitution", "frame" };
 
 // --- scene parts -------------------------------------------------------------------------------
+
+/// A tf frame id: tf2 rejects ids with a leading slash (a tf1 habit): say so here, not at run time.
+std::string readFrameId(const Context& ctx, const Field& field)
+{
+  const std::string frame = readNonEmptyString(ctx, field);
+  if (frame.front() == '/')
+    ctx.fail(field, "tf frame " + quoted(frame) + " must not start with '/'");
+  return frame;
+}
 
 /// A number in [0, 1].
 double readFraction(const Context& ctx, const Field& field)
@@ -127,6 +136,14 @@ ColliderPlacement readPlacement(const Context& ctx, const Field& field)
     at.friction = readNonNegative(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "restitution"))
     at.restitution = readFraction(ctx, *value);
+  if (const std::optional<Field> frame = optionalKey(field, "frame"))
+  {
+    at.frame = readFrameId(ctx, *frame);
+    for (const char* key : { "velocity", "angular_velocity" })
+      if (const std::optional<Field> motion = optionalKey(field, key))
+        ctx.fail(*motion, "a collider on a tf frame moves with its frame; " + std::string(key) +
+                              " is for colliders without one");
+  }
   return at;
 }
 
@@ -193,12 +210,7 @@ void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
         ctx.fail(name, "duplicate anchor name " + quoted(anchor.name));
     anchor.node = readNodeIndex(ctx, requiredKey(ctx, item, "node"), static_cast<int>(count));
     if (const std::optional<Field> frame = optionalKey(item, "frame"))
-    {
-      anchor.frame = readNonEmptyString(ctx, *frame);
-      // tf2 rejects frame ids with a leading slash (a tf1 habit): say so here, not at run time.
-      if (anchor.frame.front() == '/')
-        ctx.fail(*frame, "tf frame " + quoted(anchor.frame) + " must not start with '/'");
-    }
+      anchor.frame = readFrameId(ctx, *frame);
     body.anchors.push_back(anchor);
   }
 }

@@ -14,7 +14,7 @@ import tf2_ros
 from geometry_msgs.msg import PoseStamped, TransformStamped
 from rosgraph_msgs.msg import Log
 from std_srvs.srv import SetBool
-from visualization_msgs.msg import InteractiveMarkerFeedback, InteractiveMarkerInit
+from visualization_msgs.msg import InteractiveMarkerFeedback, InteractiveMarkerInit, MarkerArray
 
 from node_client import NodeTestCase, StateWatcher, wait_for
 from soft_body_sim.srv import Attach, Detach
@@ -83,6 +83,28 @@ class InputsTest(NodeTestCase):
             s = self.state.next(1)
             x = s.bodies[0].positions[0]
             errors.append(math.dist((x.x, x.y, x.z), gripper_position(s.header.stamp.to_sec())))
+        self.assertLess(max(errors), 0.01, errors)
+
+    def test_a_collider_follows_its_tf_frame_and_is_drawn_there(self):
+        # The finger sits 0.3 m along y from gripper_link, turned along x; its marker (the capsule's
+        # cylinder, id 0 of namespace colliders) is where the frame was at the marker's stamp, within the
+        # anchor's tolerance above.
+        drawn = []
+        subscriber = rospy.Subscriber(NODE + "/markers", MarkerArray,
+                                      lambda a: drawn.extend(m for m in a.markers if m.ns == "colliders" and m.id == 0),
+                                      queue_size=10)
+        try:
+            self.assertTrue(wait_for(lambda: len(drawn) >= 30, 20.0))
+        finally:
+            subscriber.unregister()
+        errors = []
+        for m in drawn[5:]:
+            expected = gripper_position(m.header.stamp.to_sec())
+            p = m.pose.position
+            errors.append(math.dist((p.x, p.y, p.z), (expected[0], expected[1] + 0.3, expected[2])))
+            self.assertEqual(m.type, m.CYLINDER)
+            self.assertAlmostEqual(m.pose.orientation.y, math.sqrt(0.5), places=6)
+            self.assertAlmostEqual(m.scale.z, 0.06)
         self.assertLess(max(errors), 0.01, errors)
 
     def test_a_handle_drag_publishes_on_the_anchor_topic_and_moves_the_anchor(self):

@@ -5,7 +5,10 @@
 
 #include <string>
 
+#include <optional>
+
 #include <geometry_msgs/Pose.h>
+#include <geometry_msgs/Transform.h>
 #include <geometry_msgs/Vector3.h>
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
@@ -51,6 +54,9 @@ public:
   static Vec3 toVec3(const geometry_msgs::Point& point) { return Vec3(point.x, point.y, point.z); }
   /// A translation [m], as it is.
   static Vec3 toVec3(const geometry_msgs::Vector3& vector) { return Vec3(vector.x, vector.y, vector.z); }
+
+  /// A transform as a rigid pose; nullopt if any field is not finite or the rotation is zero.
+  static std::optional<RigidPose> toRigidPose(const geometry_msgs::Transform& transform);
 
   /// The world's live physics as the node's reconfigure config (~): integrator, dt, substeps,
   /// iterations, gravity, drag.

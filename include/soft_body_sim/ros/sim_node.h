@@ -71,11 +71,15 @@ private:
   /// The pose's position in the scene frame; false (with a throttled warning naming `topic` and the
   /// reason) if it is not finite or its frame cannot be transformed.
   bool toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position);
-  /// The origin of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf
-  /// has none that recent yet); nullopt with a throttled warning if tf has none at all.
+  /// The pose of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf has
+  /// none that recent yet); nullopt with a throttled warning if tf has none at all.
+  std::optional<RigidPose> framePose(const std::string& frame, const ros::Time& stamp);
+  /// framePose's position.
   std::optional<Vec3> frameOrigin(const std::string& frame, const ros::Time& stamp);
   /// Makes anchor `anchor` follow tf frame `frame` every step.
   void followFrame(int anchor, const std::string& frame);
+  /// A collider with a tf frame follows it: its scene pose is relative to the frame.
+  void followFrame(const ColliderPlacement& collider);
   bool onAttach(Attach::Request& request, Attach::Response& response);
   bool onDetach(Detach::Request& request, Detach::Response& response);
 
