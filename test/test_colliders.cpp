@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "soft_body_sim/core/bodies/cloth.h"
+#include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/contact.h"
 #include "test_util.h"
 
@@ -259,6 +260,59 @@ TEST(ColliderPath, APathDrivenColliderLandsOnItsPathAndDragsByItsVelocity)
   EXPECT_NEAR(poses[1].position.x(), speed * world.time(), 1e-12);
   const Eigen::Quaterniond expected(Eigen::AngleAxisd(2.0 * world.time(), Vec3::UnitZ()));
   EXPECT_NEAR(poses[0].orientation.angularDistance(expected), 0.0, 1e-9);
+}
+
+// --- a rope's segments ----------------------------------------------------------------------------------
+
+/// The distance [m] between segments p0-p1 and q0-q1, by brute force over 400 points of each.
+double segmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1)
+{
+  double nearest = 1e9;
+  for (int i = 0; i <= 400; ++i)
+    for (int j = 0; j <= 400; ++j)
+      nearest = std::min(nearest, ((p0 + (p1 - p0) * (i / 400.0)) - (q0 + (q1 - q0) * (j / 400.0))).norm());
+  return nearest;
+}
+
+// A gripper finger (a capsule of radius 1 cm) swept at 5 m/s through a hanging rope of 5 cm links, at a
+// height between two of its nodes: the rope's segments, not only its nodes, meet the finger, so it
+// pushes the rope along instead of passing between two nodes. Truth: at every step every segment keeps
+// at least the finger's radius from its axis (brute-force distance; a sub-step moves the finger 5 mm, half
+// its radius), and the rope's node next to the finger ends up ahead of where the finger passed it.
+TEST(ColliderContact, AFingerSweptThroughAHangingRopePushesItAndNeverPassesThroughASegment)
+{
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 240.0, 4, 4 };
+  RopeDef rope;
+  rope.nodes = 21;  // 5 cm links
+  rope.from = Vec3(0, 0, 1.5);
+  rope.to = Vec3(0, 0, 0.5);
+  rope.mass = 0.1;
+  rope.stiffness = 5000.0;
+  rope.pinned = { 0 };
+  scene.bodies.push_back(buildRope("rope", rope));
+  Capsule finger;
+  finger.at.name = "finger";
+  finger.radius = 0.01;
+  finger.length = 0.2;
+  finger.at.position = Vec3(-0.3, 0, 1.025);  // between nodes 9 (z = 1.05) and 10 (z = 1.0)
+  finger.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * kPi, Vec3::UnitX()));  // along y
+  finger.at.velocity = Vec3(5.0, 0, 0);
+  scene.colliders.capsules.push_back(finger);
+  World world = buildWorld(scene);
+  double closest = 1e9;
+  for (int n = 0; n < 24; ++n)  // 0.1 s: the finger goes from x = -0.3 to 0.2 m
+  {
+    world.step();
+    const Vec3 centre = world.colliderPoses()[0].position;
+    const Vec3 end0 = centre - Vec3(0, 0.1, 0), end1 = centre + Vec3(0, 0.1, 0);
+    for (int i = 0; i + 1 < rope.nodes; ++i)
+      closest = std::min(closest, segmentDistance(world.state().position.col(i), world.state().position.col(i + 1),
+                                                  end0, end1));
+  }
+  EXPECT_GE(closest, finger.radius - 1e-3);  // within the brute force's resolution (0.2 m / 400 along the finger)
+  EXPECT_GT(world.state().position(0, 10), 0.2);  // pushed ahead of the finger's path, not left behind
 }
 
 // --- a cloth onto a sphere -------------------------------------------------------------------------------

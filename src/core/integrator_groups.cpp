@@ -95,6 +95,7 @@ void IntegratorGroups::rebuild(const Model& model)
       return std::any_of(std::begin(c.nodes), std::end(c.nodes), mine);
     });
     m.colliders = Colliders{};
+    m.contact_segments.clear();
     groups_.push_back(std::move(group));
   }
 }

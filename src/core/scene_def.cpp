@@ -91,6 +91,8 @@ World buildWorld(const SceneDef& scene)
                                     "counter-clockwise about its normal) and a positive pressure");
       model.cells.push_back(cell);
     }
+    for (const auto& [a, b] : body.contact_segments)
+      model.contact_segments.emplace_back(globalIndex(body, first, a), globalIndex(body, first, b));
     for (const AnchorDef& anchor : body.anchors)
     {
       const int node = globalIndex(body, first, anchor.node);

@@ -2,6 +2,7 @@
 // surfaceDistance (colliders.h). Private to the core.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
@@ -66,6 +67,8 @@ public:
       touching_[static_cast<std::size_t>(i)] = touched ? 1 : 0;
       touched_any = touched_any || touched;
     }
+    for (const auto& [a, b] : model.contact_segments)
+      touched_any = resolveSegment(model, start, state, h, a, b) || touched_any;
     return touched_any;
   }
 
@@ -125,6 +128,67 @@ public:
   }
 
 private:
+  /// A segment between nodes a and b, of their mean contact radius, against every shape: where the shape
+  /// comes nearest to the segment's interior (the ends are nodes, resolved above), that point leaves the
+  /// shape as a node would, and the correction is shared by the two nodes in proportion to their
+  /// inverse masses and their weights at the point (the point moves by exactly the correction).
+  bool resolveSegment(const Model& model, const NodeArray& start, State& state, double h, int a, int b)
+  {
+    const double wa = model.inverse_mass[a], wb = model.inverse_mass[b];
+    if (wa == 0.0 && wb == 0.0)
+      return false;
+    const double radius = 0.5 * (model.contact_radius[a] + model.contact_radius[b]);
+    bool touched = false;
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      if (!placed_[k])
+        continue;
+      const Shape& shape = shapes_[k];
+      const ColliderPlacement& at = shape.at;
+      const Vec3 xa = state.position.col(a), xb = state.position.col(b);
+      const Vec3 la = at.orientation.conjugate() * (xa - at.position);
+      const Vec3 lb = at.orientation.conjugate() * (xb - at.position);
+      const Vec3 d = lb - la;
+      // Cheap rejection: the segment's nearest point to the shape's origin is beyond its bounding ball.
+      const double length2 = d.squaredNorm();
+      const double s0 = length2 > 0.0 ? std::clamp(-la.dot(d) / length2, 0.0, 1.0) : 0.0;
+      if ((la + s0 * d).norm() > boundingRadius(shape) + radius)
+        continue;
+      // The distance to a convex shape along a line is convex: a ternary search finds its minimum.
+      double lo = 0.0, hi = 1.0;
+      for (int iteration = 0; iteration < 40; ++iteration)
+      {
+        const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+        if (surfaceDistance(shape, la + m1 * d).distance < surfaceDistance(shape, la + m2 * d).distance)
+          hi = m2;
+        else
+          lo = m1;
+      }
+      const double t = 0.5 * (lo + hi);
+      if (t < 1e-6 || t > 1.0 - 1e-6)
+        continue;  // an end: its node's contact
+      const SurfaceDistance surface = surfaceDistance(shape, la + t * d);
+      const double depth = radius - surface.distance;
+      if (!(depth > 0.0))
+        continue;
+      touched = true;
+      const double s = (1.0 - t) * (1.0 - t) * wa + t * t * wb;
+      const Vec3 normal = at.orientation * surface.normal;
+      const Vec3 contact = at.position + at.orientation * surface.closest;
+      const Vec3 velocity = at.velocity + at.angular_velocity.cross(contact - at.position);
+      Vec3 x = (1.0 - t) * xa + t * xb;
+      Vec3 v = (1.0 - t) * state.velocity.col(a) + t * state.velocity.col(b);
+      const Vec3 moved = x - ((1.0 - t) * start.col(a) + t * start.col(b));
+      const Vec3 x0 = x, v0 = v;
+      leaveSurface({ normal, velocity, at.friction, at.restitution }, depth, false, h, moved, x, v);
+      state.position.col(a) += (1.0 - t) * wa / s * (x - x0);
+      state.position.col(b) += t * wb / s * (x - x0);
+      state.velocity.col(a) += (1.0 - t) * wa / s * (v - v0);
+      state.velocity.col(b) += t * wb / s * (v - v0);
+    }
+    return touched;
+  }
+
   /// Every shape moves by its constant velocity and turns by its angular velocity over h.
   void move(double h)
   {

@@ -95,4 +95,9 @@ SurfaceDistance surfaceDistance(const Sphere& sphere, const Eigen::Vector3d& loc
 SurfaceDistance surfaceDistance(const Capsule& capsule, const Eigen::Vector3d& local);
 SurfaceDistance surfaceDistance(const Box& box, const Eigen::Vector3d& local);
 
+/// The radius [m] of a ball about the shape's origin that holds it.
+inline double boundingRadius(const Sphere& sphere) { return sphere.radius; }
+inline double boundingRadius(const Capsule& capsule) { return 0.5 * capsule.length + capsule.radius; }
+inline double boundingRadius(const Box& box) { return 0.5 * box.size.norm(); }
+
 }  // namespace soft_body_sim

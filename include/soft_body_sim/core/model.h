@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -79,6 +80,9 @@ struct Model
   Eigen::VectorXd mass;          ///< [kg] per node (kept for pinned nodes too, for reporting)
   Eigen::VectorXd inverse_mass;  ///< [1/kg] per node, 0 for pinned nodes
   Eigen::VectorXd contact_radius;  ///< [m] per node: how far it keeps from colliders (0 = a point)
+  /// Segments that collide along their length (a rope's links), as global node index pairs; their
+  /// radius is their nodes' contact radius.
+  std::vector<std::pair<int, int>> contact_segments;
   std::vector<Spring> springs;
   std::vector<DistanceConstraint> constraints;
   std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then

@@ -78,6 +78,9 @@ struct BodyDef
   std::vector<AnchorDef> anchors;
   ControllerFactory controller;  ///< empty for passive bodies
   double contact_radius = 0.0;   ///< [m] >= 0: how far its nodes keep from colliders (0 = points)
+  /// Pairs of node indices within the body whose segment collides as a whole (a rope's links), not
+  /// only at its ends.
+  std::vector<std::pair<int, int>> contact_segments;
 };
 
 struct PhysicsDef

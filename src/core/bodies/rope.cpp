@@ -32,7 +32,10 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
     body.nodes[static_cast<std::size_t>(resolveNodeIndex(index, rope.nodes))].pinned = true;
   // Rest lengths stay empty: the straight initial layout is the rest shape.
   for (int i = 0; i + 1 < rope.nodes; ++i)
+  {
     body.springs.push_back(SpringDef{ i, i + 1, rope.stiffness, rope.damping, std::nullopt });
+    body.contact_segments.emplace_back(i, i + 1);
+  }
   if (rope.bending > 0.0)
     for (int i = 0; i + 2 < rope.nodes; ++i)
       body.springs.push_back(SpringDef{ i, i + 2, rope.bending, rope.bending_damping, std::nullopt });
