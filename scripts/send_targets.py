@@ -1,6 +1,7 @@
 #!/usr/bin/python3
-"""Example client of soft_body_sim: drives a creature's target along a figure eight and an anchor
-around a circle, stamping each pose with the ROS time it is meant for, as a planner would.
+"""Example client of soft_body_sim: drives a creature's target along a figure eight, an anchor around
+a circle and a gripper's tf frame up and down, stamping each pose with the ROS time it is meant for, as
+a planner would.
 
   rosrun soft_body_sim send_targets.py                 # the demo's codeling and the rope's right end
   rosrun soft_body_sim send_targets.py _target_topic:=/soft_body_sim/figure/target _anchor_topic:=''
@@ -14,7 +15,12 @@ Parameters (private, all optional):
   ~anchor_center  [m] centre of the circle, in the x-z plane (default [-6.75, 0.0, 1.5])
   ~anchor_radius  [m] (default 0.25)
   ~anchor_period  [s] one turn (default 4)
-  ~frame_id       frame of both paths (default world)
+  ~gripper_frame  tf frame broadcast as a child of ~frame_id, moving up and down (default gripper;
+                  '' = none): the demo's two fingers follow it
+  ~gripper_center [m] centre of its motion (default [-7.05, 0.0, 1.25])
+  ~gripper_height [m] it rises this far above the centre and as far below (default 0.35)
+  ~gripper_period [s] one up and down (default 6)
+  ~frame_id       frame of every path (default world)
   ~rate           [Hz] poses per second on each topic (default 20)
   ~lead           [s] each pose is stamped this far ahead of now, so that it reaches the simulator
                   before its step and a replay of the recording is exact (default 0.1)
@@ -22,7 +28,8 @@ Parameters (private, all optional):
 import math
 
 import rospy
-from geometry_msgs.msg import PoseStamped
+import tf2_ros
+from geometry_msgs.msg import PoseStamped, TransformStamped
 
 
 def pose(frame_id, stamp, x, y, z):
@@ -46,6 +53,22 @@ def circle(center, radius, period, t):
     return center[0] + radius * math.cos(w * t), center[1], center[2] + radius * math.sin(w * t)
 
 
+def up_and_down(center, height, period, t):
+    """A vertical oscillation about the centre, starting at its lowest point."""
+    w = 2.0 * math.pi / period
+    return center[0], center[1], center[2] - height * math.cos(w * t)
+
+
+def transform(frame_id, child, stamp, x, y, z):
+    message = TransformStamped()
+    message.header.frame_id = frame_id
+    message.header.stamp = stamp
+    message.child_frame_id = child
+    message.transform.translation.x, message.transform.translation.y, message.transform.translation.z = x, y, z
+    message.transform.rotation.w = 1.0
+    return message
+
+
 def main():
     rospy.init_node("send_targets")
     frame_id = rospy.get_param("~frame_id", "world")
@@ -59,9 +82,14 @@ def main():
     anchor_center = rospy.get_param("~anchor_center", [-6.75, 0.0, 1.5])
     anchor_radius = rospy.get_param("~anchor_radius", 0.25)
     anchor_period = rospy.get_param("~anchor_period", 4.0)
+    gripper_frame = rospy.get_param("~gripper_frame", "gripper")
+    gripper_center = rospy.get_param("~gripper_center", [-7.05, 0.0, 1.25])
+    gripper_height = rospy.get_param("~gripper_height", 0.35)
+    gripper_period = rospy.get_param("~gripper_period", 6.0)
 
     target_pub = rospy.Publisher(target_topic, PoseStamped, queue_size=10) if target_topic else None
     anchor_pub = rospy.Publisher(anchor_topic, PoseStamped, queue_size=10) if anchor_topic else None
+    broadcaster = tf2_ros.TransformBroadcaster() if gripper_frame else None
     while rospy.Time.now().is_zero() and not rospy.is_shutdown():  # /use_sim_time: wait for /clock
         rospy.sleep(0.01)
     start = rospy.Time.now()
@@ -73,6 +101,9 @@ def main():
             target_pub.publish(pose(frame_id, stamp, *figure_eight(target_center, target_size, target_period, t)))
         if anchor_pub:
             anchor_pub.publish(pose(frame_id, stamp, *circle(anchor_center, anchor_radius, anchor_period, t)))
+        if broadcaster:
+            broadcaster.sendTransform(transform(frame_id, gripper_frame, stamp,
+                                                *up_and_down(gripper_center, gripper_height, gripper_period, t)))
         try:
             ticker.sleep()
         except rospy.ROSInterruptException:
