@@ -17,7 +17,7 @@ Parameters (private, all optional):
   ~anchor_period  [s] one turn (default 4)
   ~gripper_frame  tf frame broadcast as a child of ~frame_id, moving up and down (default gripper;
                   '' = none): the demo's two fingers follow it
-  ~gripper_center [m] centre of its motion (default [-7.05, 0.0, 1.25])
+  ~gripper_center [m] centre of its motion (default [-7.25, 0.0, 1.25])
   ~gripper_height [m] it rises this far above the centre and as far below (default 0.35)
   ~gripper_period [s] one up and down (default 6)
   ~frame_id       frame of every path (default world)
@@ -83,7 +83,7 @@ def main():
     anchor_radius = rospy.get_param("~anchor_radius", 0.25)
     anchor_period = rospy.get_param("~anchor_period", 4.0)
     gripper_frame = rospy.get_param("~gripper_frame", "gripper")
-    gripper_center = rospy.get_param("~gripper_center", [-7.05, 0.0, 1.25])
+    gripper_center = rospy.get_param("~gripper_center", [-7.25, 0.0, 1.25])
     gripper_height = rospy.get_param("~gripper_height", 0.35)
     gripper_period = rospy.get_param("~gripper_period", 6.0)
 

@@ -41,6 +41,28 @@ Vec3 circle(const Vec3& center, double radius, double period, double t)
   return center + Vec3(radius * std::cos(w * t), 0.0, radius * std::sin(w * t));
 }
 
+/// send_targets.py's gripper frame: up and down about its centre, starting at its lowest point.
+Vec3 upAndDown(const Vec3& center, double height, double period, double t)
+{
+  return center - Vec3(0.0, 0.0, height * std::cos(2.0 * M_PI / period * t));
+}
+
+/// The demo's fingers follow send_targets.py's gripper frame, as the node makes them follow tf: each
+/// finger's scene pose is relative to the frame.
+void followTheDemosGripper(World& world)
+{
+  for (const ColliderPlacement* at : placements(world.model().colliders))
+  {
+    if (at->frame != "gripper")
+      continue;
+    const RigidPose local{ at->position, at->orientation };
+    ASSERT_TRUE(world.followColliderPath(at->name, [local](double t) {
+      return std::optional<RigidPose>(
+          RigidPose{ upAndDown(Vec3(-7.25, 0.0, 1.25), 0.35, 6.0, t) + local.position, local.orientation });
+    }));
+  }
+}
+
 /// The demo scene with only the named bodies (and its floor), stepped with `integrator`.
 SceneDef demoWith(const std::vector<std::string>& bodies, IntegratorType integrator)
 {
@@ -233,9 +255,10 @@ TEST(StreamedTargets, TheHumanoidWalksTheFigureEightForTwoMinutes)
 
 TEST(StreamedAnchors, TheDemosRopeEndCirclesForTwoMinutesWithEveryStableIntegrator)
 {
-  // send_targets.py's circle (0.25 m, 4 s, 0.39 m/s) on the rope's right end. The anchor is at each
-  // streamed pose at the end of the step after it (World::moveAnchor), up to round-off; the rope's nodes,
-  // hanging between a fixed end and one moving at 0.39 m/s, stay far below 10 m/s.
+  // send_targets.py's circle (0.25 m, 4 s, 0.39 m/s) on the rope's right end, and its gripper (two
+  // fingers, up and down by 0.35 m in 6 s) lifting the rope. The anchor is at each streamed pose at the
+  // end of the step after it (World::moveAnchor), up to round-off; the rope's nodes, hanging between a
+  // fixed end and one moving at 0.39 m/s and lifted at 0.37 m/s at most, stay far below 10 m/s.
   const SceneDef scene = demoWith({ "rope" }, IntegratorType::Xpbd);
   for (const IntegratorType integrator : stableIntegrators(scene))
   {
@@ -243,6 +266,7 @@ TEST(StreamedAnchors, TheDemosRopeEndCirclesForTwoMinutesWithEveryStableIntegrat
     SceneDef with = scene;
     with.physics.integrator = integrator;
     World world = buildWorld(with);
+    followTheDemosGripper(world);
     const std::optional<int> right = world.findAnchor("rope", "right");
     ASSERT_TRUE(right);
     const int node = world.model().anchors[static_cast<std::size_t>(*right)].node;

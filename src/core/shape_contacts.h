@@ -17,6 +17,9 @@ namespace soft_body_sim
 /// orientation (normalised here), friction >= 0 and restitution in [0, 1].
 void preparePlacement(ColliderPlacement& at);
 
+/// The most a segment contact moves either node per unit of the contact point's correction.
+constexpr double kMaxLever = 2.0;
+
 template <typename Shape>
 class ShapeContacts final : public ColliderKind
 {
@@ -181,10 +184,14 @@ private:
       const Vec3 moved = x - ((1.0 - t) * start.col(a) + t * start.col(b));
       const Vec3 x0 = x, v0 = v;
       leaveSurface({ normal, velocity, at.friction, at.restitution }, depth, false, h, moved, x, v);
-      state.position.col(a) += (1.0 - t) * wa / s * (x - x0);
-      state.position.col(b) += t * wb / s * (x - x0);
-      state.velocity.col(a) += (1.0 - t) * wa / s * (v - v0);
-      state.velocity.col(b) += t * wb / s * (v - v0);
+      // Next to a pinned (or much heavier) end the free node is a lever's long arm: moving the point by D
+      // takes D / (1 - t) of it. Beyond kMaxLever the contact is left partly unresolved, since such a
+      // point is all but on the pinned node, which contact cannot move.
+      const double ka = std::min((1.0 - t) * wa / s, kMaxLever), kb = std::min(t * wb / s, kMaxLever);
+      state.position.col(a) += ka * (x - x0);
+      state.position.col(b) += kb * (x - x0);
+      state.velocity.col(a) += ka * (v - v0);
+      state.velocity.col(b) += kb * (v - v0);
     }
     return touched;
   }
