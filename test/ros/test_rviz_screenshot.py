@@ -93,7 +93,8 @@ class RvizScreenshotTest(unittest.TestCase):
         deadline = time.monotonic() + 20.0
         while not os.path.exists(f"/tmp/.X11-unix/X{display[1:]}") and time.monotonic() < deadline:
             time.sleep(0.1)
-        demo = self.start(["roslaunch", "soft_body_sim", "demo.launch", "send_targets:=false"], env=env)
+        # As shipped, with send_targets.py: the gripper's fingers appear once their tf frame does.
+        demo = self.start(["roslaunch", "soft_body_sim", "demo.launch"], env=env)
 
         # rviz takes a while to start on software GL; look every few seconds until all bodies show.
         columns, image = {}, None
