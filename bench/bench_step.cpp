@@ -6,6 +6,9 @@
 // Cloths of 100 to 100,000 nodes (BM_ClothStep/<integrator>/<nodes>) give the cost per spring update
 // (items = spring updates) and how the step cost grows with the node count (scripts/bench fits the
 // log-log slope); BM_ClothSpringForces is the force kernel alone on the 10,000-node cloth.
+// Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
+// capsules or boxes, against the same rope with none (the price of contact, and that a scene without
+// colliders pays nothing for them); items = node-collider pairs checked per step.
 #include <cmath>
 
 #include <benchmark/benchmark.h>
@@ -103,6 +106,63 @@ void BM_ClothSpringForces(benchmark::State& bench)
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.springs.size()));
 }
 
+enum class Shape
+{
+  Sphere,
+  Capsule,
+  Box
+};
+
+/// A rope of `nodes` nodes along x (1 m per 100 nodes, radius 5 mm) lying across `colliders` shapes of
+/// `shape` spread evenly under it, at a ROS node's step (xpbd, 1/240 s, 4 sub-steps).
+SceneDef ropeOnColliders(int nodes, int colliders, Shape shape)
+{
+  RopeDef rope;
+  rope.nodes = nodes;
+  const double length = nodes / 100.0;
+  rope.from = Vec3(0, 0, 0.105);
+  rope.to = Vec3(length, 0, 0.105);
+  rope.mass = 0.01 * length;
+  rope.stiffness = 1e4;
+  rope.radius = 0.005;
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 240.0, 4, 1 };
+  scene.bodies.push_back(buildRope("rope", rope));
+  for (int k = 0; k < colliders; ++k)
+  {
+    ColliderPlacement at;
+    at.name = "c" + std::to_string(k);
+    at.position = Vec3((k + 0.5) * length / colliders, 0, 0);
+    at.friction = 0.5;
+    if (shape == Shape::Sphere)
+      scene.colliders.spheres.push_back(Sphere{ at, 0.1 });
+    else if (shape == Shape::Capsule)
+    {
+      at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitX()));  // across the rope
+      scene.colliders.capsules.push_back(Capsule{ at, 0.1, 0.3 });
+    }
+    else
+      scene.colliders.boxes.push_back(Box{ at, Vec3(0.2, 0.3, 0.2) });
+  }
+  return scene;
+}
+
+void BM_RopeOnColliders(benchmark::State& bench, Shape shape)
+{
+  const int nodes = static_cast<int>(bench.range(0)), colliders = static_cast<int>(bench.range(1));
+  World world = buildWorld(ropeOnColliders(nodes, colliders, shape));
+  for (int n = 0; n < 240; ++n)  // one second: the rope drapes over them and the arrays are sized
+    world.step();
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(nodes) * std::max(colliders, 1) *
+                          world.settings().substeps);
+}
+
 /// Node counts from 100 to 100,000, two per decade.
 void clothSizes(benchmark::internal::Benchmark* bench)
 {
@@ -122,6 +182,9 @@ BENCHMARK_CAPTURE(BM_ClothStep, semi_implicit_euler, IntegratorType::SemiImplici
 BENCHMARK_CAPTURE(BM_ClothStep, xpbd, IntegratorType::Xpbd)->Apply(clothSizes);
 BENCHMARK_CAPTURE(BM_ClothStep, implicit_euler, IntegratorType::ImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000);
 BENCHMARK(BM_ClothSpringForces)->Arg(10000);
+BENCHMARK_CAPTURE(BM_RopeOnColliders, sphere, Shape::Sphere)->Args({ 1000, 0 })->Args({ 1000, 10 });
+BENCHMARK_CAPTURE(BM_RopeOnColliders, capsule, Shape::Capsule)->Args({ 1000, 10 });
+BENCHMARK_CAPTURE(BM_RopeOnColliders, box, Shape::Box)->Args({ 1000, 10 });
 
 }  // namespace
 }  // namespace soft_body_sim

@@ -13,6 +13,7 @@
 
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
+#include "../src/core/shape_contacts.h"
 #include "soft_body_sim/core/contact.h"
 #include "test_util.h"
 
@@ -148,6 +149,43 @@ TEST(ColliderGeometry, DistanceNormalAndClosestPointAgreeWithABruteForceReferenc
   expectAgreesWithBruteForce(sphere, "sphere");
   expectAgreesWithBruteForce(capsule, "capsule");
   expectAgreesWithBruteForce(box, "box");
+}
+
+// Where a segment comes nearest a shape (shape_contacts.h: closed forms for spheres and capsules, a
+// ternary search for boxes) against sampling the segment at 20,001 points.
+TEST(ColliderGeometry, TheNearestPointOfASegmentAgreesWithSampling)
+{
+  Sphere sphere;
+  sphere.radius = 0.3;
+  Capsule capsule;
+  capsule.radius = 0.1;
+  capsule.length = 0.5;
+  Box box;
+  box.size = Vec3(0.5, 0.3, 0.2);
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
+  // `search`: the ternary search's bracket, (2/3)^24 of the segment (0 for the closed forms).
+  const auto check = [&](const auto& shape, const char* name, double search) {
+    for (int k = 0; k < 200; ++k)
+    {
+      const Vec3 a(coordinate(random), coordinate(random), coordinate(random));
+      const Vec3 d = Vec3(coordinate(random), coordinate(random), coordinate(random)) * 0.3;
+      double best = 1e9;
+      for (int i = 0; i <= 20000; ++i)
+        best = std::min(best, surfaceDistance(shape, a + (i / 20000.0) * d).distance);
+      const double t = nearestParameter(shape, a, d);
+      SCOPED_TRACE(name);
+      EXPECT_GE(t, 0.0);
+      EXPECT_LE(t, 1.0);
+      // Never farther than the best sample (but for the search's bracket), and samples lie 1/20000 of the
+      // segment apart.
+      EXPECT_LE(surfaceDistance(shape, a + t * d).distance, best + 1e-9 + search * d.norm());
+      EXPECT_GE(surfaceDistance(shape, a + t * d).distance, best - d.norm() / 20000.0);
+    }
+  };
+  check(sphere, "sphere", 0.0);
+  check(capsule, "capsule", 0.0);
+  check(box, "box", std::pow(2.0 / 3.0, 24));
 }
 
 // --- a node on a tilted box ----------------------------------------------------------------------------

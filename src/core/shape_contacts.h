@@ -17,6 +17,52 @@ namespace soft_body_sim
 /// orientation (normalised here), friction >= 0 and restitution in [0, 1].
 void preparePlacement(ColliderPlacement& at);
 
+/// Where along the segment la + t d (t in [0, 1], in the shape's local frame) the shape is nearest: the
+/// distance to a convex shape along a line is convex, so a ternary search finds it, to (2/3)^24 = 6e-5 of
+/// the link (3 um of a 5 cm link). Spheres and capsules have closed forms below.
+template <typename Shape>
+double nearestParameter(const Shape& shape, const Vec3& la, const Vec3& d)
+{
+  double lo = 0.0, hi = 1.0;
+  for (int iteration = 0; iteration < 24; ++iteration)
+  {
+    const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+    if (surfaceDistance(shape, la + m1 * d).distance < surfaceDistance(shape, la + m2 * d).distance)
+      hi = m2;
+    else
+      lo = m1;
+  }
+  return 0.5 * (lo + hi);
+}
+
+/// A sphere is nearest where its centre is.
+inline double nearestParameter(const Sphere& /*sphere*/, const Vec3& la, const Vec3& d)
+{
+  const double length2 = d.squaredNorm();
+  return length2 > 0.0 ? std::clamp(-la.dot(d) / length2, 0.0, 1.0) : 0.0;
+}
+
+/// A capsule is nearest where its axis is: the closest points of two segments (Ericson, Real-Time
+/// Collision Detection, 5.1.9).
+inline double nearestParameter(const Capsule& capsule, const Vec3& la, const Vec3& d)
+{
+  const Vec3 q0(0.0, 0.0, -0.5 * capsule.length), axis(0.0, 0.0, capsule.length);
+  const Vec3 r = la - q0;
+  const double a = d.squaredNorm(), e = axis.squaredNorm(), f = axis.dot(r), c = d.dot(r);
+  if (!(a > 0.0))
+    return 0.0;
+  if (!(e > 0.0))
+    return std::clamp(-c / a, 0.0, 1.0);
+  const double b = d.dot(axis), denominator = a * e - b * b;
+  double t = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+  const double s = (b * t + f) / e;
+  if (s < 0.0)
+    t = std::clamp(-c / a, 0.0, 1.0);
+  else if (s > 1.0)
+    t = std::clamp((b - c) / a, 0.0, 1.0);
+  return t;
+}
+
 /// The most a segment contact moves either node per unit of the contact point's correction.
 constexpr double kMaxLever = 2.0;
 
@@ -30,6 +76,7 @@ public:
     for (Shape& shape : shapes_)
     {
       preparePlacement(shape.at);
+      bounds_.push_back(boundingRadius(shape));
       // A shape on a tf frame has no place in the scene until its frame's first pose lands.
       placed_.push_back(shape.at.frame.empty() ? 1 : 0);
     }
@@ -54,7 +101,11 @@ public:
           continue;
         const Shape& shape = shapes_[k];
         const ColliderPlacement& at = shape.at;
-        const Vec3 local = at.orientation.conjugate() * (Vec3(state.position.col(i)) - at.position);
+        const Vec3 offset = Vec3(state.position.col(i)) - at.position;
+        const double reach = bounds_[k] + radius;
+        if (offset.squaredNorm() > reach * reach)
+          continue;  // outside the shape's bounding ball: no need to look closer
+        const Vec3 local = at.orientation.conjugate() * offset;
         const SurfaceDistance surface = surfaceDistance(shape, local);
         const double depth = radius - surface.distance;
         if (!(depth > 0.0))
@@ -149,25 +200,16 @@ private:
       const Shape& shape = shapes_[k];
       const ColliderPlacement& at = shape.at;
       const Vec3 xa = state.position.col(a), xb = state.position.col(b);
-      const Vec3 la = at.orientation.conjugate() * (xa - at.position);
-      const Vec3 lb = at.orientation.conjugate() * (xb - at.position);
-      const Vec3 d = lb - la;
       // Cheap rejection: the segment's nearest point to the shape's origin is beyond its bounding ball.
-      const double length2 = d.squaredNorm();
-      const double s0 = length2 > 0.0 ? std::clamp(-la.dot(d) / length2, 0.0, 1.0) : 0.0;
-      if ((la + s0 * d).norm() > boundingRadius(shape) + radius)
+      const Vec3 oa = xa - at.position, link = xb - xa;
+      const double length2 = link.squaredNorm();
+      const double s0 = length2 > 0.0 ? std::clamp(-oa.dot(link) / length2, 0.0, 1.0) : 0.0;
+      const double reach = bounds_[k] + radius;
+      if ((oa + s0 * link).squaredNorm() > reach * reach)
         continue;
-      // The distance to a convex shape along a line is convex: a ternary search finds its minimum.
-      double lo = 0.0, hi = 1.0;
-      for (int iteration = 0; iteration < 40; ++iteration)
-      {
-        const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
-        if (surfaceDistance(shape, la + m1 * d).distance < surfaceDistance(shape, la + m2 * d).distance)
-          hi = m2;
-        else
-          lo = m1;
-      }
-      const double t = 0.5 * (lo + hi);
+      const Vec3 la = at.orientation.conjugate() * oa;
+      const Vec3 d = at.orientation.conjugate() * link;
+      const double t = nearestParameter(shape, la, d);
       if (t < 1e-6 || t > 1.0 - 1e-6)
         continue;  // an end: its node's contact
       const SurfaceDistance surface = surfaceDistance(shape, la + t * d);
@@ -213,6 +255,7 @@ private:
   std::vector<Shape> shapes_;
   std::vector<std::optional<RigidPose>> goals_;  ///< per shape: where it arrives at this step's end
   std::vector<char> placed_;                     ///< per shape: has a pose in the scene (collides, is drawn)
+  std::vector<double> bounds_;                   ///< per shape: boundingRadius [m]
   std::vector<std::uint8_t> touching_;  ///< per node: on one of these shapes after the last sub-step
 };
 
