@@ -137,15 +137,24 @@ void expectAgreesWithBruteForce(const Shape& shape, const char* name)
   }
 }
 
+/// One shape of each kind, about the origin, for the geometry tests.
+struct TestShapes
+{
+  TestShapes()
+  {
+    sphere.radius = 0.3;
+    capsule.radius = 0.12;
+    capsule.length = 0.5;
+    box.size = Vec3(0.5, 0.3, 0.2);
+  }
+  Sphere sphere;
+  Capsule capsule;
+  Box box;
+};
+
 TEST(ColliderGeometry, DistanceNormalAndClosestPointAgreeWithABruteForceReference)
 {
-  Sphere sphere;
-  sphere.radius = 0.3;
-  Capsule capsule;
-  capsule.radius = 0.12;
-  capsule.length = 0.5;
-  Box box;
-  box.size = Vec3(0.5, 0.3, 0.2);
+  const auto [sphere, capsule, box] = TestShapes();
   expectAgreesWithBruteForce(sphere, "sphere");
   expectAgreesWithBruteForce(capsule, "capsule");
   expectAgreesWithBruteForce(box, "box");
@@ -155,13 +164,7 @@ TEST(ColliderGeometry, DistanceNormalAndClosestPointAgreeWithABruteForceReferenc
 // ternary search for boxes) against sampling the segment at 20,001 points.
 TEST(ColliderGeometry, TheNearestPointOfASegmentAgreesWithSampling)
 {
-  Sphere sphere;
-  sphere.radius = 0.3;
-  Capsule capsule;
-  capsule.radius = 0.1;
-  capsule.length = 0.5;
-  Box box;
-  box.size = Vec3(0.5, 0.3, 0.2);
+  const auto [sphere, capsule, box] = TestShapes();
   std::mt19937 random(11);
   std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
   // `search`: the ternary search's bracket, (2/3)^24 of the segment (0 for the closed forms).
