@@ -74,6 +74,30 @@ SampledSurface sample(const Capsule& capsule)
   return s;
 }
 
+SampledSurface sample(const Cylinder& cylinder)
+{
+  SampledSurface s;
+  const double r = cylinder.radius, half = 0.5 * cylinder.length, step = 0.003;
+  const int around = static_cast<int>(std::ceil(2.0 * kPi * r / step)), along = static_cast<int>(std::ceil(cylinder.length / step));
+  for (int i = 0; i < around; ++i)
+  {
+    const double a = 2.0 * kPi * i / around;
+    for (int j = 0; j <= along; ++j)  // the mantle
+      s.points.emplace_back(r * std::cos(a), r * std::sin(a), -half + cylinder.length * j / along);
+  }
+  const int rings = static_cast<int>(std::ceil(r / step));
+  for (const double z : { -half, half })  // the caps, as rings
+    for (int k = 0; k <= rings; ++k)
+    {
+      const double rk = r * k / rings;
+      const int count = std::max(1, static_cast<int>(std::ceil(2.0 * kPi * rk / step)));
+      for (int i = 0; i < count; ++i)
+        s.points.emplace_back(rk * std::cos(2.0 * kPi * i / count), rk * std::sin(2.0 * kPi * i / count), z);
+    }
+  s.spacing = 2.0 * step;
+  return s;
+}
+
 SampledSurface sample(const Box& box)
 {
   SampledSurface s;
@@ -106,6 +130,10 @@ bool inside(const Capsule& capsule, const Vec3& p)
   return (p - Vec3(0, 0, z)).norm() < capsule.radius;
 }
 bool inside(const Box& box, const Vec3& p) { return ((p.cwiseAbs() - 0.5 * box.size).array() < 0.0).all(); }
+bool inside(const Cylinder& c, const Vec3& p)
+{
+  return std::hypot(p.x(), p.y()) < c.radius && std::abs(p.z()) < 0.5 * c.length;
+}
 
 template <typename Shape>
 void expectAgreesWithBruteForce(const Shape& shape, const char* name)
@@ -146,15 +174,19 @@ struct TestShapes
     capsule.radius = 0.12;
     capsule.length = 0.5;
     box.size = Vec3(0.5, 0.3, 0.2);
+    cylinder.radius = 0.15;
+    cylinder.length = 0.4;
   }
   Sphere sphere;
   Capsule capsule;
   Box box;
+  Cylinder cylinder;
 };
 
 TEST(ColliderGeometry, DistanceNormalAndClosestPointAgreeWithABruteForceReference)
 {
-  const auto [sphere, capsule, box] = TestShapes();
+  const auto [sphere, capsule, box, cylinder] = TestShapes();
+  expectAgreesWithBruteForce(cylinder, "cylinder");
   expectAgreesWithBruteForce(sphere, "sphere");
   expectAgreesWithBruteForce(capsule, "capsule");
   expectAgreesWithBruteForce(box, "box");
@@ -164,7 +196,7 @@ TEST(ColliderGeometry, DistanceNormalAndClosestPointAgreeWithABruteForceReferenc
 // ternary search for boxes) against sampling the segment at 20,001 points.
 TEST(ColliderGeometry, TheNearestPointOfASegmentAgreesWithSampling)
 {
-  const auto [sphere, capsule, box] = TestShapes();
+  const auto [sphere, capsule, box, cylinder] = TestShapes();
   std::mt19937 random(11);
   std::uniform_real_distribution<double> coordinate(-0.7, 0.7);
   // `search`: the ternary search's bracket, (2/3)^24 of the segment (0 for the closed forms).
@@ -189,6 +221,7 @@ TEST(ColliderGeometry, TheNearestPointOfASegmentAgreesWithSampling)
   check(sphere, "sphere", 0.0);
   check(capsule, "capsule", 0.0);
   check(box, "box", std::pow(2.0 / 3.0, 24));
+  check(cylinder, "cylinder", std::pow(2.0 / 3.0, 24));
 }
 
 // --- a node on a tilted box ----------------------------------------------------------------------------

@@ -1029,6 +1029,7 @@ TEST(SceneLoader, CollidersAndContactRadiiAreRead)
     velocity: [0.5, 0, 0]
     angular_velocity: [0, 0, 2]
   - {name: finger, shape: capsule, radius: 0.008, length: 0.06, frame: gripper_link}
+  - {name: post, shape: cylinder, radius: 0.05, length: 1.2, position: [2, 0, 0.6]}
 bodies:
   - {name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 10, radius: 0.005}
   - {name: c, type: cloth, nx: 2, ny: 2, top_left: [0, 0, 1], top_right: [1, 0, 1], bottom_left: [0, 1, 1],
@@ -1052,6 +1053,9 @@ bodies:
   EXPECT_EQ(scene.colliders.capsules[0].length, 0.5);
   EXPECT_EQ(scene.colliders.capsules[0].at.frame, "");
   EXPECT_EQ(scene.colliders.capsules[1].at.frame, "gripper_link");
+  ASSERT_EQ(scene.colliders.cylinders.size(), 1u);
+  EXPECT_EQ(scene.colliders.cylinders[0].radius, 0.05);
+  EXPECT_EQ(scene.colliders.cylinders[0].length, 1.2);
   expectVec3(scene.colliders.capsules[0].at.velocity, 0.5, 0, 0);
   expectVec3(scene.colliders.capsules[0].at.angular_velocity, 0, 0, 2);
   EXPECT_EQ(scene.bodies[0].contact_radius, 0.005);
@@ -1059,14 +1063,14 @@ bodies:
   const World world = buildWorld(scene);
   EXPECT_EQ(world.model().contact_radius[0], 0.005);
   EXPECT_EQ(world.model().contact_radius[3], 0.002);
-  ASSERT_EQ(world.colliderPoses().size(), 3u);  // the finger appears once tf knows its frame
+  ASSERT_EQ(world.colliderPoses().size(), 4u);  // the finger appears once tf knows its frame
 }
 
 TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
 {
   const std::string body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";
   expectSceneError("colliders: [{name: a, shape: cone, radius: 1}]\n" + body, "bad.yaml:1: colliders[0].shape",
-                   { "unknown shape 'cone'", "sphere, capsule, box" });
+                   { "unknown shape 'cone'", "sphere, capsule, cylinder, box" });
   expectSceneError("colliders: [{name: a, shape: sphere, radius: 0}]\n" + body, "bad.yaml:1: colliders[0].radius",
                    { "> 0" });
   expectSceneError("colliders: [{name: a, shape: box, size: [1, 0, 1]}]\n" + body, "bad.yaml:1: colliders[0].size",

@@ -59,4 +59,36 @@ SurfaceDistance surfaceDistance(const Box& box, const Eigen::Vector3d& local)
   return s;
 }
 
+SurfaceDistance surfaceDistance(const Cylinder& cylinder, const Eigen::Vector3d& local)
+{
+  const double half = 0.5 * cylinder.length;
+  const double r = std::hypot(local.x(), local.y());
+  const Eigen::Vector3d radial = r > 0.0 ? Eigen::Vector3d(local.x() / r, local.y() / r, 0.0) : Eigen::Vector3d::UnitX();
+  const double side = r - cylinder.radius;            // > 0 outside the mantle's radius
+  const double cap = std::abs(local.z()) - half;      // > 0 beyond a cap's plane
+  const Eigen::Vector3d axial(0.0, 0.0, local.z() < 0.0 ? -1.0 : 1.0);
+  SurfaceDistance s;
+  if (side > 0.0 && cap > 0.0)
+  {
+    // Nearest the rim where the mantle meets a cap.
+    s.closest = cylinder.radius * radial + half * axial;
+    s.distance = (local - s.closest).norm();
+    s.normal = (local - s.closest) / s.distance;
+  }
+  else if (side > cap)
+  {
+    // Out through the mantle (outside beside it, or inside nearer to it than to a cap).
+    s.distance = side;
+    s.normal = radial;
+    s.closest = Eigen::Vector3d(cylinder.radius * radial.x(), cylinder.radius * radial.y(), local.z());
+  }
+  else
+  {
+    s.distance = cap;
+    s.normal = axial;
+    s.closest = Eigen::Vector3d(local.x(), local.y(), half * axial.z());
+  }
+  return s;
+}
+
 }  // namespace soft_body_sim

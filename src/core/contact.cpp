@@ -40,6 +40,7 @@ std::vector<std::unique_ptr<ColliderKind>> makeColliderKinds(const Model& model)
   addShapes(kinds, model.colliders.spheres, model.nodeCount());
   addShapes(kinds, model.colliders.capsules, model.nodeCount());
   addShapes(kinds, model.colliders.boxes, model.nodeCount());
+  addShapes(kinds, model.colliders.cylinders, model.nodeCount());
   return kinds;
 }
 

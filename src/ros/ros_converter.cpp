@@ -80,7 +80,7 @@ void addColliderMarkers(const World& world, const std::string& frame_id, const r
     const ColliderPose& c = poses[k];
     const int id = 3 * static_cast<int>(k);
     int type = visualization_msgs::Marker::SPHERE;
-    if (c.shape == ColliderPose::Shape::Capsule)
+    if (c.shape == ColliderPose::Shape::Capsule || c.shape == ColliderPose::Shape::Cylinder)
       type = visualization_msgs::Marker::CYLINDER;
     else if (c.shape == ColliderPose::Shape::Box)
       type = visualization_msgs::Marker::CUBE;

@@ -177,6 +177,15 @@ void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
     capsule.length = readNonNegative(ctx, requiredKey(ctx, field, "length"));
     colliders.capsules.push_back(capsule);
   }
+  else if (name == "cylinder")
+  {
+    requireMap(ctx, field, withPlacementKeys({ "radius", "length" }));
+    Cylinder cylinder;
+    cylinder.at = readPlacement(ctx, field);
+    cylinder.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
+    cylinder.length = readPositive(ctx, requiredKey(ctx, field, "length"));
+    colliders.cylinders.push_back(cylinder);
+  }
   else if (name == "box")
   {
     requireMap(ctx, field, withPlacementKeys({ "size" }));
@@ -190,7 +199,7 @@ void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
   }
   else
   {
-    ctx.fail(shape, "unknown shape " + quoted(name) + "; valid shapes: sphere, capsule, box");
+    ctx.fail(shape, "unknown shape " + quoted(name) + "; valid shapes: sphere, capsule, cylinder, box");
   }
 }
 

@@ -3,6 +3,7 @@
 // which checks and prepares its shapes when the world is built and keeps their live poses.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,15 @@ struct Capsule
   double length = 0.5;   ///< [m] between the end centres, >= 0
 };
 
+/// A solid cylinder of `radius` [m] and `length` [m] along its local z axis, centred on its origin (flat
+/// caps at z = +-length / 2), as URDF's <cylinder>.
+struct Cylinder
+{
+  ColliderPlacement at;
+  double radius = 0.05;  ///< [m], > 0
+  double length = 0.5;   ///< [m], > 0
+};
+
 /// A box of full extents `size` [m] along its local x, y, z, centred on its origin.
 struct Box
 {
@@ -65,9 +75,10 @@ struct Colliders
   std::vector<Sphere> spheres;
   std::vector<Capsule> capsules;
   std::vector<Box> boxes;
+  std::vector<Cylinder> cylinders;
 };
 
-/// Every shape's placement, in the order of Colliders' vectors (spheres, capsules, boxes): for the
+/// Every shape's placement, in the order of Colliders' vectors (spheres, capsules, boxes, cylinders): for the
 /// callers that treat all shapes alike (which follow a tf frame).
 inline std::vector<const ColliderPlacement*> placements(const Colliders& colliders)
 {
@@ -78,6 +89,8 @@ inline std::vector<const ColliderPlacement*> placements(const Colliders& collide
     all.push_back(&c.at);
   for (const Box& b : colliders.boxes)
     all.push_back(&b.at);
+  for (const Cylinder& c : colliders.cylinders)
+    all.push_back(&c.at);
   return all;
 }
 
@@ -94,10 +107,12 @@ struct SurfaceDistance
 SurfaceDistance surfaceDistance(const Sphere& sphere, const Eigen::Vector3d& local);
 SurfaceDistance surfaceDistance(const Capsule& capsule, const Eigen::Vector3d& local);
 SurfaceDistance surfaceDistance(const Box& box, const Eigen::Vector3d& local);
+SurfaceDistance surfaceDistance(const Cylinder& cylinder, const Eigen::Vector3d& local);
 
 /// The radius [m] of a ball about the shape's origin that holds it.
 inline double boundingRadius(const Sphere& sphere) { return sphere.radius; }
 inline double boundingRadius(const Capsule& capsule) { return 0.5 * capsule.length + capsule.radius; }
 inline double boundingRadius(const Box& box) { return 0.5 * box.size.norm(); }
+inline double boundingRadius(const Cylinder& c) { return std::hypot(c.radius, 0.5 * c.length); }
 
 }  // namespace soft_body_sim

@@ -23,13 +23,14 @@ struct ColliderPose
   {
     Sphere,
     Capsule,
-    Box
+    Box,
+    Cylinder
   };
   std::string name;
   Shape shape = Shape::Sphere;
   Vec3 position = Vec3::Zero();                                   ///< [m] of its origin
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
-  /// [m] sphere: its diameter three times; capsule: (2 radius, 2 radius, length); box: its size.
+  /// [m] sphere: its diameter three times; capsule and cylinder: (2 radius, 2 radius, length); box: its size.
   Vec3 size = Vec3::Zero();
 
   static ColliderPose of(const Sphere& s) { return { s.at.name, Shape::Sphere, s.at.position, s.at.orientation, Vec3::Constant(2.0 * s.radius) }; }
@@ -38,6 +39,10 @@ struct ColliderPose
     return { c.at.name, Shape::Capsule, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length) };
   }
   static ColliderPose of(const Box& b) { return { b.at.name, Shape::Box, b.at.position, b.at.orientation, b.size }; }
+  static ColliderPose of(const Cylinder& c)
+  {
+    return { c.at.name, Shape::Cylinder, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length) };
+  }
 };
 
 /// A rigid pose: position [m] and orientation (unit quaternion) of a collider's origin and axes.
