@@ -100,6 +100,24 @@ SceneDef everyFeatureScene(IntegratorType integrator)
   scene.physics.step.iterations = 2;
   scene.physics.drag = 0.1;
   scene.colliders.planes = { Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.2, 0.5 } };
+  // A rigid shape of each kind, one of them moving, under the rope (whose links collide too).
+  ColliderPlacement at;
+  at.friction = 0.5;
+  at.name = "ball";
+  at.position = Vec3(-1.8, 0.0, 0.8);
+  scene.colliders.spheres.push_back(Sphere{ at, 0.15 });
+  at.name = "rod";
+  at.position = Vec3(-1.5, 0.0, 0.85);
+  at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(1.5707963267948966, Vec3::UnitX()));
+  at.velocity = Vec3(0.0, 0.0, 0.2);
+  scene.colliders.capsules.push_back(Capsule{ at, 0.05, 0.4 });
+  at.name = "block";
+  at.position = Vec3(-1.2, 0.0, 0.8);
+  at.velocity = Vec3::Zero();
+  scene.colliders.boxes.push_back(Box{ at, Vec3(0.2, 0.3, 0.2) });
+  at.name = "post";
+  at.position = Vec3(-1.05, 0.0, 0.8);
+  scene.colliders.cylinders.push_back(Cylinder{ at, 0.05, 0.3 });
 
   RopeDef rope;
   rope.nodes = 12;
@@ -108,6 +126,7 @@ SceneDef everyFeatureScene(IntegratorType integrator)
   rope.stiffness = 500.0;
   rope.damping = 0.01;
   rope.bending = 10.0;
+  rope.radius = 0.01;
   rope.pinned = { 0, -1 };
   BodyDef rope_body = buildRope("rope", rope);
   for (int i = 0; i + 1 < rope.nodes; ++i)
