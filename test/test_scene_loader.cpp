@@ -230,7 +230,7 @@ const BadScene kBadScenes[] = {
   { "UnknownTopLevelKey", R"(frame: world
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
-    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, rate, physics, planes, colliders, bodies" } },
+    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, rate, physics, planes, colliders, robot_colliders, bodies" } },
   { "UnknownPhysicsKey", R"(physics:
   dt: 0.01
   timestep: 0.01
@@ -790,7 +790,7 @@ bodies: []
   { "TopLevelIsAList", R"(- name: b
   type: custom
 )",
-    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, rate, physics, planes, colliders, bodies", "a list" } },
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, rate, physics, planes, colliders, robot_colliders, bodies", "a list" } },
   { "TopLevelIsAScalar", R"(hello
 )",
     "bad.yaml:1: (top level)", { "must be a YAML mapping", "'hello'" } },
@@ -1030,6 +1030,7 @@ TEST(SceneLoader, CollidersAndContactRadiiAreRead)
     angular_velocity: [0, 0, 2]
   - {name: finger, shape: capsule, radius: 0.008, length: 0.06, frame: gripper_link}
   - {name: post, shape: cylinder, radius: 0.05, length: 1.2, position: [2, 0, 0.6]}
+robot_colliders: {param: my_robot, friction: 0.4}
 bodies:
   - {name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 10, radius: 0.005}
   - {name: c, type: cloth, nx: 2, ny: 2, top_left: [0, 0, 1], top_right: [1, 0, 1], bottom_left: [0, 1, 1],
@@ -1053,6 +1054,10 @@ bodies:
   EXPECT_EQ(scene.colliders.capsules[0].length, 0.5);
   EXPECT_EQ(scene.colliders.capsules[0].at.frame, "");
   EXPECT_EQ(scene.colliders.capsules[1].at.frame, "gripper_link");
+  ASSERT_TRUE(scene.robot_colliders);
+  EXPECT_EQ(scene.robot_colliders->param, "my_robot");
+  EXPECT_EQ(scene.robot_colliders->friction, 0.4);
+  EXPECT_EQ(scene.robot_colliders->restitution, 0.0);
   ASSERT_EQ(scene.colliders.cylinders.size(), 1u);
   EXPECT_EQ(scene.colliders.cylinders[0].radius, 0.05);
   EXPECT_EQ(scene.colliders.cylinders[0].length, 1.2);
@@ -1085,6 +1090,10 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
                    "bad.yaml:1: colliders[0].velocity", { "moves with its frame" });
   expectSceneError("colliders: [{name: a, shape: sphere, radius: 1, frame: /hand}]\n" + body,
                    "bad.yaml:1: colliders[0].frame", { "must not start with '/'" });
+  expectSceneError("robot_colliders: {param: robot_description, friction: -0.5}\n" + body,
+                   "bad.yaml:1: robot_colliders.friction", { ">= 0" });
+  expectSceneError("robot_colliders: {urdf: robot.urdf}\n" + body, "bad.yaml:1: robot_colliders.urdf",
+                   { "unknown key", "param, friction, restitution" });
   expectSceneError("colliders: [{name: a, shape: sphere, radius: 1}, {name: a, shape: sphere, radius: 2}]\n" + body,
                    "bad.yaml:1: colliders[1].name", { "duplicate collider name 'a'" });
   expectSceneError("bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1, "

@@ -5,6 +5,7 @@
 #include <std_msgs/Time.h>
 
 #include "soft_body_sim/SimState.h"
+#include "soft_body_sim/ros/robot_colliders.h"
 #include "soft_body_sim/scene/scene_loader.h"
 
 namespace soft_body_sim
@@ -32,6 +33,8 @@ void SimNode::initialize()
   if (!private_nh_.getParam("scene", scene_path_))
     throw std::runtime_error(private_nh_.resolveName("scene") + ": parameter not set (the scene file to load)");
   scene_ = loadSceneFile(scene_path_);
+  if (scene_.robot_colliders)
+    addRobotColliders();
   rate_ = scene_.rate;
   if (private_nh_.getParam("rate", rate_) && !(rate_ > 0.0 && std::isfinite(rate_)))
     throw std::runtime_error(private_nh_.resolveName("rate") + ": must be a finite number > 0 [Hz]");
@@ -62,6 +65,26 @@ void SimNode::initialize()
   ROS_INFO("%s: scene %s, %d nodes in %zu bodies, %s at dt = %g s, publishing at %g Hz in frame '%s'", name_.c_str(),
            scene_path_.c_str(), world_->model().nodeCount(), world_->model().bodies.size(),
            integratorName(world_->integrator()).c_str(), world_->settings().dt, rate_, scene_.frame_id.c_str());
+}
+
+void SimNode::addRobotColliders()
+{
+  const RobotCollidersDef& robot = *scene_.robot_colliders;
+  std::string urdf;
+  if (!nh_.getParam(robot.param, urdf))
+    throw std::runtime_error(scene_path_ + ": robot_colliders.param: the parameter '" + nh_.resolveName(robot.param) +
+                             "' is not set (it should hold the robot's URDF)");
+  std::vector<std::string> skipped;
+  try
+  {
+    soft_body_sim::addRobotColliders(urdf, robot, scene_.colliders, skipped);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw std::runtime_error(scene_path_ + ": " + e.what());
+  }
+  for (const std::string& collision : skipped)
+    ROS_WARN("%s: robot collision %s left out", name_.c_str(), collision.c_str());
 }
 
 void SimNode::buildWorldFromScene()

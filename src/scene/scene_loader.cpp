@@ -17,7 +17,7 @@ namespace
 {
 using namespace scene_yaml;
 
-const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "colliders", "bodies" };
+const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "colliders", "robot_colliders", "bodies" };
 const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag", "guard" };
 const Keys kGuardKeys = { "policy", "max_speed" };
 const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
@@ -203,6 +203,19 @@ void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
   }
 }
 
+RobotCollidersDef readRobotColliders(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, { "param", "friction", "restitution" });
+  RobotCollidersDef robot;
+  if (const std::optional<Field> value = optionalKey(field, "param"))
+    robot.param = readNonEmptyString(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "friction"))
+    robot.friction = readNonNegative(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "restitution"))
+    robot.restitution = readFraction(ctx, *value);
+  return robot;
+}
+
 /// `anchors: [{name, node}]`, read after the body's type has expanded it, since `node` indexes the
 /// expanded body; a negative index counts from the end (-1 is the last node).
 void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
@@ -274,6 +287,9 @@ SceneDef readScene(const Context& ctx, const Field& root)
                                                      first->second + ")");
     }
   }
+
+  if (const std::optional<Field> robot = optionalKey(root, "robot_colliders"))
+    scene.robot_colliders = readRobotColliders(ctx, *robot);
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error

@@ -94,12 +94,22 @@ struct PhysicsDef
   GuardSettings guard;                      ///< what the divergence guard does (guard.h)
 };
 
+/// `robot_colliders:`: every <collision> of the URDF on a ROS parameter becomes a collider following its
+/// link's tf frame (read by the ROS node: robot_colliders.h).
+struct RobotCollidersDef
+{
+  std::string param = "robot_description";  ///< the parameter holding the URDF (resolved as a global name)
+  double friction = 0.0;                     ///< Coulomb coefficient [-] of every such collider, >= 0
+  double restitution = 0.0;                  ///< [0, 1]
+};
+
 struct SceneDef
 {
   std::string frame_id = "world";  ///< fixed frame of the simulation
   double rate = 60.0;              ///< [Hz] at which the ROS node advances and publishes, > 0
   PhysicsDef physics;
   Colliders colliders;  ///< what every body collides with (colliders.h)
+  std::optional<RobotCollidersDef> robot_colliders;  ///< more colliders from a URDF (ROS node only)
   std::vector<BodyDef> bodies;
 };
 

@@ -78,6 +78,8 @@ private:
   std::optional<Vec3> frameOrigin(const std::string& frame, const ros::Time& stamp);
   /// Makes anchor `anchor` follow tf frame `frame` every step.
   void followFrame(int anchor, const std::string& frame);
+  /// The scene's robot_colliders: the URDF's collisions join scene_'s colliders (throws, saying why).
+  void addRobotColliders();
   /// A collider with a tf frame follows it: its scene pose is relative to the frame.
   void followFrame(const ColliderPlacement& collider);
   bool onAttach(Attach::Request& request, Attach::Response& response);
