@@ -154,6 +154,19 @@ Keys withPlacementKeys(const Keys& own)
   return keys;
 }
 
+/// A shape with a radius and a length (capsule, cylinder): radius > 0, length > 0 (>= 0 if `zero_length`).
+template <typename Shape>
+Shape readRadiusAndLength(const Context& ctx, const Field& field, bool zero_length)
+{
+  requireMap(ctx, field, withPlacementKeys({ "radius", "length" }));
+  Shape shape;
+  shape.at = readPlacement(ctx, field);
+  shape.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
+  const Field length = requiredKey(ctx, field, "length");
+  shape.length = zero_length ? readNonNegative(ctx, length) : readPositive(ctx, length);
+  return shape;
+}
+
 /// One item of `colliders:`, added to `colliders` by its shape.
 void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
 {
@@ -170,21 +183,11 @@ void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
   }
   else if (name == "capsule")
   {
-    requireMap(ctx, field, withPlacementKeys({ "radius", "length" }));
-    Capsule capsule;
-    capsule.at = readPlacement(ctx, field);
-    capsule.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
-    capsule.length = readNonNegative(ctx, requiredKey(ctx, field, "length"));
-    colliders.capsules.push_back(capsule);
+    colliders.capsules.push_back(readRadiusAndLength<Capsule>(ctx, field, true));  // a capsule may be a ball
   }
   else if (name == "cylinder")
   {
-    requireMap(ctx, field, withPlacementKeys({ "radius", "length" }));
-    Cylinder cylinder;
-    cylinder.at = readPlacement(ctx, field);
-    cylinder.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
-    cylinder.length = readPositive(ctx, requiredKey(ctx, field, "length"));
-    colliders.cylinders.push_back(cylinder);
+    colliders.cylinders.push_back(readRadiusAndLength<Cylinder>(ctx, field, false));
   }
   else if (name == "box")
   {
