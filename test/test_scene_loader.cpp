@@ -1042,9 +1042,9 @@ bodies:
   EXPECT_EQ(table.at.name, "table");
   expectVec3(table.size, 1.0, 0.6, 0.05);
   expectVec3(table.at.position, 0.0, 0.0, 0.7);
-  // [x y z w] = [0 0 1 1], normalised: a quarter turn about z.
-  EXPECT_NEAR(table.at.orientation.z(), std::sqrt(0.5), 1e-15);
-  EXPECT_NEAR(table.at.orientation.w(), std::sqrt(0.5), 1e-15);
+  // [x y z w] = [0 0 1 1] as written; the world normalises it: a quarter turn about z.
+  EXPECT_EQ(table.at.orientation.z(), 1.0);
+  EXPECT_EQ(table.at.orientation.w(), 1.0);
   EXPECT_EQ(table.at.friction, 0.5);
   EXPECT_EQ(table.at.restitution, 0.25);
   ASSERT_EQ(scene.colliders.spheres.size(), 1u);
@@ -1069,6 +1069,10 @@ bodies:
   EXPECT_EQ(world.model().contact_radius[0], 0.005);
   EXPECT_EQ(world.model().contact_radius[3], 0.002);
   ASSERT_EQ(world.colliderPoses().size(), 4u);  // the finger appears once tf knows its frame
+  const ColliderPose& table_pose = world.colliderPoses()[2];  // ball, rod, table, post (the finger unplaced)
+  EXPECT_EQ(table_pose.name, "table");
+  EXPECT_NEAR(table_pose.orientation.z(), std::sqrt(0.5), 1e-15);
+  EXPECT_NEAR(table_pose.orientation.w(), std::sqrt(0.5), 1e-15);
 }
 
 TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)

@@ -2,11 +2,33 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
+
+#include "soft_body_sim/core/definition_error.h"
 
 namespace soft_body_sim
 {
 namespace
 {
+void checkPlacement(const ColliderPlacement& at)
+{
+  const std::string what = "collider '" + at.name + "'";
+  requireDefinition(at.position.allFinite(), what, { "position" }, "position must be finite");
+  requireDefinition(at.velocity.allFinite(), what, { "velocity" }, "velocity must be finite");
+  requireDefinition(at.angular_velocity.allFinite(), what, { "angular_velocity" }, "angular_velocity must be finite");
+  requireDefinition(at.orientation.coeffs().allFinite() && at.orientation.norm() > 1e-12, what, { "orientation" },
+                    "orientation must be a finite quaternion, not the zero quaternion");
+  requireDefinition(at.friction >= 0.0 && std::isfinite(at.friction), what, { "friction" }, "friction must be >= 0");
+  requireDefinition(at.restitution >= 0.0 && at.restitution <= 1.0, what, { "restitution" },
+                    "restitution must be in [0, 1]");
+}
+
+void checkRadius(const ColliderPlacement& at, double radius)
+{
+  requireDefinition(radius > 0.0 && std::isfinite(radius), "collider '" + at.name + "'", { "radius" },
+                    "radius must be > 0");
+}
+
 /// Outward distance from a ball of `radius` about the origin, with the +z normal at the centre.
 SurfaceDistance ball(const Eigen::Vector3d& p, double radius)
 {
@@ -18,6 +40,35 @@ SurfaceDistance ball(const Eigen::Vector3d& p, double radius)
   return s;
 }
 }  // namespace
+
+void checkCollider(const Sphere& sphere)
+{
+  checkPlacement(sphere.at);
+  checkRadius(sphere.at, sphere.radius);
+}
+
+void checkCollider(const Capsule& capsule)
+{
+  checkPlacement(capsule.at);
+  checkRadius(capsule.at, capsule.radius);
+  requireDefinition(capsule.length >= 0.0 && std::isfinite(capsule.length), "collider '" + capsule.at.name + "'",
+                    { "length" }, "length must be >= 0");
+}
+
+void checkCollider(const Box& box)
+{
+  checkPlacement(box.at);
+  requireDefinition(box.size.allFinite() && box.size.minCoeff() > 0.0, "collider '" + box.at.name + "'", { "size" },
+                    "every extent of size must be > 0");
+}
+
+void checkCollider(const Cylinder& cylinder)
+{
+  checkPlacement(cylinder.at);
+  checkRadius(cylinder.at, cylinder.radius);
+  requireDefinition(cylinder.length > 0.0 && std::isfinite(cylinder.length), "collider '" + cylinder.at.name + "'",
+                    { "length" }, "length must be > 0");
+}
 
 SurfaceDistance surfaceDistance(const Sphere& sphere, const Eigen::Vector3d& local)
 {

@@ -13,10 +13,6 @@
 
 namespace soft_body_sim
 {
-/// Throws std::invalid_argument unless the placement is usable: a finite pose and motion, a non-zero
-/// orientation (normalised here), friction >= 0 and restitution in [0, 1].
-void preparePlacement(ColliderPlacement& at);
-
 /// Where along the segment la + t d (t in [0, 1], in the shape's local frame) the shape is nearest: the
 /// distance to a convex shape along a line is convex, so a ternary search finds it, to (2/3)^24 = 6e-5 of
 /// the link (3 um of a 5 cm link). Spheres and capsules have closed forms below.
@@ -75,7 +71,8 @@ public:
   {
     for (Shape& shape : shapes_)
     {
-      preparePlacement(shape.at);
+      checkCollider(shape);
+      shape.at.orientation.normalize();
       bounds_.push_back(boundingRadius(shape));
       // A shape on a tf frame has no place in the scene until its frame's first pose lands.
       placed_.push_back(shape.at.frame.empty() ? 1 : 0);

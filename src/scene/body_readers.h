@@ -55,6 +55,13 @@ struct SceneSoFar
 /// "tendrils.mass" looks into nested mappings), else `map` itself.
 Field firstPresent(const Field& map, const std::vector<std::string>& keys);
 
+/// Reports `error` at the first of its keys that `map` sets, echoing the file's value there.
+[[noreturn]] inline void failAtKeys(const Context& ctx, const Field& map, const DefinitionError& error)
+{
+  const Field at = firstPresent(map, error.keys());
+  ctx.fail(at, error.what() + (at.node.IsScalar() ? ", got " + at.node.Scalar() : std::string()));
+}
+
 /// The last stage of every generated body's reader: `build(name, def)` (buildRope, buildCreature, ...)
 /// with the body's `name`. The builder checks the definition; its DefinitionError becomes one line at the
 /// first of the keys it names that the file sets (any other std::invalid_argument: at the body).
@@ -68,8 +75,7 @@ BodyDef buildBody(const Context& ctx, const Field& field, const Def& def, Build 
   }
   catch (const DefinitionError& e)
   {
-    const Field at = firstPresent(field, e.keys());
-    ctx.fail(at, e.what() + (at.node.IsScalar() ? ", got " + at.node.Scalar() : std::string()));
+    failAtKeys(ctx, field, e);
   }
   catch (const std::invalid_argument& e)
   {

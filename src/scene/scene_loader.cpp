@@ -112,7 +112,7 @@ Plane readPlane(const Context& ctx, const Field& field)
   return plane;
 }
 
-/// The keys every collider shape has: name, pose, motion and surface.
+/// The keys every collider shape has: name, pose, motion and surface (checked by checkCollider).
 ColliderPlacement readPlacement(const Context& ctx, const Field& field)
 {
   ColliderPlacement at;
@@ -124,18 +124,15 @@ ColliderPlacement readPlacement(const Context& ctx, const Field& field)
     const std::vector<Field> q = requireListOfSize(ctx, *value, 4, "numbers (a quaternion x, y, z, w)");
     at.orientation = Eigen::Quaterniond(readNumber(ctx, q[3]), readNumber(ctx, q[0]), readNumber(ctx, q[1]),
                                         readNumber(ctx, q[2]));
-    if (!(at.orientation.norm() > 1e-12))
-      ctx.fail(*value, "must not be the zero quaternion");
-    at.orientation.normalize();
   }
   if (const std::optional<Field> value = optionalKey(field, "velocity"))
     at.velocity = readVec3(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "angular_velocity"))
     at.angular_velocity = readVec3(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "friction"))
-    at.friction = readNonNegative(ctx, *value);
+    at.friction = readNumber(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "restitution"))
-    at.restitution = readFraction(ctx, *value);
+    at.restitution = readNumber(ctx, *value);
   if (const std::optional<Field> frame = optionalKey(field, "frame"))
   {
     at.frame = readFrameId(ctx, *frame);
@@ -154,16 +151,30 @@ Keys withPlacementKeys(const Keys& own)
   return keys;
 }
 
-/// A shape with a radius and a length (capsule, cylinder): radius > 0, length > 0 (>= 0 if `zero_length`).
+/// `shape` as parsed, checked by checkCollider (its error at the key it names), appended to `shapes`.
 template <typename Shape>
-Shape readRadiusAndLength(const Context& ctx, const Field& field, bool zero_length)
+void addChecked(const Context& ctx, const Field& field, const Shape& shape, std::vector<Shape>& shapes)
+{
+  try
+  {
+    checkCollider(shape);
+  }
+  catch (const DefinitionError& e)
+  {
+    failAtKeys(ctx, field, e);
+  }
+  shapes.push_back(shape);
+}
+
+/// A shape with a radius and a length (capsule, cylinder).
+template <typename Shape>
+Shape readRadiusAndLength(const Context& ctx, const Field& field)
 {
   requireMap(ctx, field, withPlacementKeys({ "radius", "length" }));
   Shape shape;
   shape.at = readPlacement(ctx, field);
-  shape.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
-  const Field length = requiredKey(ctx, field, "length");
-  shape.length = zero_length ? readNonNegative(ctx, length) : readPositive(ctx, length);
+  shape.radius = readNumber(ctx, requiredKey(ctx, field, "radius"));
+  shape.length = readNumber(ctx, requiredKey(ctx, field, "length"));
   return shape;
 }
 
@@ -178,27 +189,24 @@ void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
     requireMap(ctx, field, withPlacementKeys({ "radius" }));
     Sphere sphere;
     sphere.at = readPlacement(ctx, field);
-    sphere.radius = readPositive(ctx, requiredKey(ctx, field, "radius"));
-    colliders.spheres.push_back(sphere);
+    sphere.radius = readNumber(ctx, requiredKey(ctx, field, "radius"));
+    addChecked(ctx, field, sphere, colliders.spheres);
   }
   else if (name == "capsule")
   {
-    colliders.capsules.push_back(readRadiusAndLength<Capsule>(ctx, field, true));  // a capsule may be a ball
+    addChecked(ctx, field, readRadiusAndLength<Capsule>(ctx, field), colliders.capsules);
   }
   else if (name == "cylinder")
   {
-    colliders.cylinders.push_back(readRadiusAndLength<Cylinder>(ctx, field, false));
+    addChecked(ctx, field, readRadiusAndLength<Cylinder>(ctx, field), colliders.cylinders);
   }
   else if (name == "box")
   {
     requireMap(ctx, field, withPlacementKeys({ "size" }));
     Box box;
     box.at = readPlacement(ctx, field);
-    const Field size = requiredKey(ctx, field, "size");
-    box.size = readVec3(ctx, size);
-    if (!(box.size.minCoeff() > 0.0))
-      ctx.fail(size, "every extent must be > 0");
-    colliders.boxes.push_back(box);
+    box.size = readVec3(ctx, requiredKey(ctx, field, "size"));
+    addChecked(ctx, field, box, colliders.boxes);
   }
   else
   {

@@ -94,6 +94,14 @@ inline std::vector<const ColliderPlacement*> placements(const Colliders& collide
   return all;
 }
 
+/// Checks a collider as a scene declares it: a finite pose and motion, a non-zero orientation (any
+/// length: it is normalised where it is used), friction >= 0, restitution in [0, 1] and positive
+/// extents (a capsule's length may be 0). Throws DefinitionError naming the keys at fault.
+void checkCollider(const Sphere& sphere);
+void checkCollider(const Capsule& capsule);
+void checkCollider(const Box& box);
+void checkCollider(const Cylinder& cylinder);
+
 /// The nearest point of a shape's surface to a point, in the shape's local frame.
 struct SurfaceDistance
 {

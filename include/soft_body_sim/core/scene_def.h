@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/definition_error.h"
 #include "soft_body_sim/core/guard.h"
 #include "soft_body_sim/core/integrator.h"
 #include "soft_body_sim/core/model.h"
@@ -116,31 +117,6 @@ struct SceneDef
 /// The most nodes a scene may have, in all its bodies: a typo such as `nx: 100000` or
 /// `segments: 1e9` fails with a message rather than exhausting memory.
 constexpr long long kMaxSceneNodes = 1000000;
-
-/// A definition that its builder rejects (buildRope, buildCreature, ...): what is wrong, and the keys of
-/// the definition it is about, in the order a reader should point at them (the scene loader reports it at
-/// the first of them that the file sets). Each check lives in the builder only; readers only parse.
-class DefinitionError : public std::invalid_argument
-{
-public:
-  DefinitionError(const std::string& what, std::vector<std::string> keys)
-    : std::invalid_argument(what), keys_(std::move(keys))
-  {
-  }
-  const std::vector<std::string>& keys() const noexcept { return keys_; }
-
-private:
-  std::vector<std::string> keys_;
-};
-
-/// Throws DefinitionError(subject + ": " + reason, keys) unless `ok`; `subject` names the definition,
-/// such as "rope 'cable'".
-inline void requireDefinition(bool ok, const std::string& subject, std::vector<std::string> keys,
-                              const std::string& reason)
-{
-  if (!ok)
-    throw DefinitionError(subject + ": " + reason, std::move(keys));
-}
 
 /// A node index of a body of `node_count` nodes made non-negative: a negative one counts from the end
 /// (-1 is the last node). Throws std::out_of_range if it is outside the body.
