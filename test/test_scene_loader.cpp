@@ -1069,7 +1069,7 @@ bodies:
   EXPECT_EQ(world.model().contact_radius[0], 0.005);
   EXPECT_EQ(world.model().contact_radius[3], 0.002);
   ASSERT_EQ(world.colliderPoses().size(), 4u);  // the finger appears once tf knows its frame
-  const ColliderPose& table_pose = world.colliderPoses()[2];  // ball, rod, table, post (the finger unplaced)
+  const ColliderPose table_pose = world.colliderPoses()[2];  // ball, rod, table, post (the finger unplaced)
   EXPECT_EQ(table_pose.name, "table");
   EXPECT_NEAR(table_pose.orientation.z(), std::sqrt(0.5), 1e-15);
   EXPECT_NEAR(table_pose.orientation.w(), std::sqrt(0.5), 1e-15);
