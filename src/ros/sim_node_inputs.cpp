@@ -22,6 +22,9 @@ constexpr int kInputQueueSize = 100;
 /// tf frame and body names longer than this are refused by their length alone, so that a huge string
 /// in a request never reaches tf2 or a log line.
 constexpr std::size_t kMaxNameLength = 256;
+/// [s] of simulated time during which a tf frame that a collider or anchor follows may still be missing
+/// without a warning (its publisher starting up).
+constexpr double kFrameGraceSeconds = 5.0;
 
 /// Why `name` cannot be a tf frame or body name (`what` says which), or empty.
 std::string badName(const std::string& what, const std::string& name)
@@ -251,8 +254,14 @@ std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros:
   }
   catch (const tf2::TransformException& e)
   {
-    ROS_WARN_THROTTLE(5.0, "%s: no transform from '%s' to '%s' yet: %s", name_.c_str(), frame.c_str(),
-                      scene_.frame_id.c_str(), e.what());
+    // At start-up the frame's publisher (robot_state_publisher, a driver) may come up a little later: a
+    // frame still missing after kFrameGraceSeconds of simulated time is worth a warning.
+    if ((stamp - epoch_).toSec() < kFrameGraceSeconds)
+      ROS_DEBUG_THROTTLE(1.0, "%s: waiting for a transform from '%s' to '%s': %s", name_.c_str(), frame.c_str(),
+                         scene_.frame_id.c_str(), e.what());
+    else
+      ROS_WARN_THROTTLE(5.0, "%s: no transform from '%s' to '%s' yet: %s", name_.c_str(), frame.c_str(),
+                        scene_.frame_id.c_str(), e.what());
     return std::nullopt;
   }
   const std::optional<RigidPose> pose = RosConverter::toRigidPose(transform.transform);
