@@ -7,7 +7,7 @@
 // (items = spring updates) and how the step cost grows with the node count (scripts/bench fits the
 // log-log slope); BM_ClothSpringForces is the force kernel alone on the 10,000-node cloth.
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
-// capsules or boxes, against the same rope with none (the price of contact, and that a scene without
+// capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
 #include <cmath>
 
@@ -16,6 +16,7 @@
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/forces.h"
 #include "large_cloth.h"
+#include "test_meshes.h"
 
 namespace soft_body_sim
 {
@@ -110,7 +111,8 @@ enum class Shape
 {
   Sphere,
   Capsule,
-  Box
+  Box,
+  Mesh
 };
 
 /// A rope of `nodes` nodes along x (1 m per 100 nodes, radius 5 mm) lying across `colliders` shapes of
@@ -129,6 +131,14 @@ SceneDef ropeOnColliders(int nodes, int colliders, Shape shape)
   scene.physics.integrator = IntegratorType::Xpbd;
   scene.physics.step = StepSettings{ 1.0 / 240.0, 4, 1 };
   scene.bodies.push_back(buildRope("rope", rope));
+  // The mesh: the sphere of radius 0.1 m again, as 100 x 51 facets (10,000 triangles), its field (2 mm
+  // voxels) built once and shared by all of them.
+  std::vector<Mesh> ball(1);
+  if (shape == Shape::Mesh)
+  {
+    ball[0].triangles = std::make_shared<const TriangleMesh>(test::uvSphere(0.1, 100, 51));
+    buildMeshFields(ball, rope.radius);
+  }
   for (int k = 0; k < colliders; ++k)
   {
     ColliderPlacement at;
@@ -142,8 +152,13 @@ SceneDef ropeOnColliders(int nodes, int colliders, Shape shape)
       at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitX()));  // across the rope
       scene.colliders.capsules.push_back(Capsule{ at, 0.1, 0.3 });
     }
-    else
+    else if (shape == Shape::Box)
       scene.colliders.boxes.push_back(Box{ at, Vec3(0.2, 0.3, 0.2) });
+    else
+    {
+      scene.colliders.meshes.push_back(ball[0]);
+      scene.colliders.meshes.back().at = at;
+    }
   }
   return scene;
 }
@@ -185,6 +200,7 @@ BENCHMARK(BM_ClothSpringForces)->Arg(10000);
 BENCHMARK_CAPTURE(BM_RopeOnColliders, sphere, Shape::Sphere)->Args({ 1000, 0 })->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, capsule, Shape::Capsule)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, box, Shape::Box)->Args({ 1000, 10 });
+BENCHMARK_CAPTURE(BM_RopeOnColliders, mesh_10k_triangles, Shape::Mesh)->Args({ 1000, 10 });
 
 }  // namespace
 }  // namespace soft_body_sim

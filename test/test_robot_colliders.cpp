@@ -1,8 +1,10 @@
 // A URDF's collisions as colliders (robot_colliders.h), parsed by ROS's urdf package, no master needed.
 #include <cmath>
+#include <cstdlib>
 
 #include <gtest/gtest.h>
 
+#include "soft_body_sim/core/mesh_field.h"
 #include "soft_body_sim/ros/robot_colliders.h"
 #include "test_util.h"
 
@@ -26,7 +28,13 @@ const char* const kRobot = R"(<?xml version="1.0"?>
     <collision><origin xyz="-0.1 0 0"/><geometry><sphere radius="0.04"/></geometry></collision>
   </link>
   <link name="cover">
-    <collision><geometry><mesh filename="package://soft_body_sim/config/meshes/cover.stl"/></geometry></collision>
+    <collision>
+      <origin xyz="0 0 0.1"/>
+      <geometry><mesh filename="package://soft_body_sim/config/meshes/part.stl" scale="2 1 0.5"/></geometry>
+    </collision>
+  </link>
+  <link name="lid">
+    <collision><geometry><mesh filename="package://soft_body_sim/config/meshes/no_such_lid.stl"/></geometry></collision>
   </link>
   <joint name="base_arm" type="revolute">
     <parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
@@ -34,10 +42,19 @@ const char* const kRobot = R"(<?xml version="1.0"?>
   </joint>
   <joint name="arm_hand" type="fixed"><parent link="arm"/><child link="hand"/></joint>
   <joint name="arm_cover" type="fixed"><parent link="arm"/><child link="cover"/></joint>
+  <joint name="arm_lid" type="fixed"><parent link="arm"/><child link="lid"/></joint>
 </robot>)";
 
-TEST(RobotColliders, EveryBoxSphereAndCylinderCollisionFollowsItsLinkInItsOriginsPose)
+/// Puts the package on ROS_PACKAGE_PATH (as `source devel/setup.bash` does) for package:// meshes.
+void findThisPackage()
 {
+  const char* previous = std::getenv("ROS_PACKAGE_PATH");
+  ::setenv("ROS_PACKAGE_PATH", (std::string(SOURCE_DIR) + (previous ? ":" + std::string(previous) : "")).c_str(), 1);
+}
+
+TEST(RobotColliders, EveryBoxSphereCylinderAndMeshCollisionFollowsItsLinkInItsOriginsPose)
+{
+  findThisPackage();
   RobotCollidersDef robot;
   robot.friction = 0.5;
   robot.restitution = 0.1;
@@ -63,9 +80,21 @@ TEST(RobotColliders, EveryBoxSphereAndCylinderCollisionFollowsItsLinkInItsOrigin
   EXPECT_EQ(colliders.spheres[1].at.name, "hand/1");
   EXPECT_EQ(colliders.spheres[1].radius, 0.04);
   EXPECT_EQ(colliders.spheres[1].at.position, Vec3(-0.1, 0, 0));
+  // The mesh at its scale (scripts/make_part_stl.py's bracket: 10 x 6 x 8 cm), its file kept for drawing.
+  ASSERT_EQ(colliders.meshes.size(), 1u);
+  const Mesh& cover = colliders.meshes[0];
+  EXPECT_EQ(cover.at.name, "cover");
+  EXPECT_EQ(cover.at.frame, "cover");
+  EXPECT_EQ(cover.at.position, Vec3(0, 0, 0.1));
+  EXPECT_EQ(cover.uri, "package://soft_body_sim/config/meshes/part.stl");
+  EXPECT_EQ(cover.scale, Vec3(2, 1, 0.5));
+  ASSERT_TRUE(cover.triangles);
+  EXPECT_TRUE(expectNear(Vec3(cover.triangles->upper() - cover.triangles->lower()), Vec3(0.2, 0.06, 0.04), 1e-6));
+  // A mesh that cannot be read is left out, named with its file and the reason.
   ASSERT_EQ(skipped.size(), 1u);
-  EXPECT_NE(skipped[0].find("cover"), std::string::npos);
-  EXPECT_NE(skipped[0].find("mesh"), std::string::npos);
+  EXPECT_NE(skipped[0].find("lid"), std::string::npos) << skipped[0];
+  EXPECT_NE(skipped[0].find("no_such_lid.stl"), std::string::npos) << skipped[0];
+  EXPECT_NE(skipped[0].find("cannot be read"), std::string::npos) << skipped[0];
 }
 
 TEST(RobotColliders, NoURDFNoCollisionOrATakenNameIsRefusedSayingWhy)
@@ -83,7 +112,7 @@ TEST(RobotColliders, NoURDFNoCollisionOrATakenNameIsRefusedSayingWhy)
     return std::string("accepted");
   };
   EXPECT_NE(refusal("<robot name='r'><link name='a'/>").find("no valid URDF"), std::string::npos);
-  EXPECT_NE(refusal("<robot name='bare'><link name='a'/></robot>").find("has no box, sphere or cylinder"),
+  EXPECT_NE(refusal("<robot name='bare'><link name='a'/></robot>").find("has no box, sphere, cylinder or readable mesh"),
             std::string::npos);
   Colliders taken;
   taken.spheres.push_back(Sphere{});

@@ -7,6 +7,7 @@
 
 #include "soft_body_sim/core/bodies/humanoid.h"
 #include "soft_body_sim/core/bodies/rope.h"
+#include "soft_body_sim/core/mesh_field.h"
 #include "soft_body_sim/ros/ros_converter.h"
 #include "test_util.h"
 
@@ -122,7 +123,14 @@ TEST(RosConverter, CollidersAreDrawnInTheirCurrentPoseWithTheirExtents)
   Box table;
   table.at.name = "table";
   table.size = Vec3(1.0, 0.6, 0.05);
-  scene.colliders = Colliders{ {}, { ball }, { rod }, { table } };
+  Mesh part;
+  part.at.name = "part";
+  part.at.position = Vec3(0, 0, -3);
+  part.uri = "package://soft_body_sim/config/meshes/part.stl";
+  part.scale = Vec3(2, 1, 0.5);
+  part.triangles = std::make_shared<const TriangleMesh>(TriangleMesh{
+      { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1) }, { { 0, 2, 1 }, { 0, 1, 3 }, { 0, 3, 2 }, { 1, 2, 3 } } });
+  scene.colliders = Colliders{ {}, { ball }, { rod }, { table }, {}, { part } };
   World world = buildWorld(scene);
   world.step();  // the rod moves by 2 m/s x 0.5 s
   const visualization_msgs::MarkerArray markers = RosConverter::toMarkers(world, "world", ros::Time(3.0));
@@ -130,7 +138,7 @@ TEST(RosConverter, CollidersAreDrawnInTheirCurrentPoseWithTheirExtents)
   for (const visualization_msgs::Marker& m : markers.markers)
     if (m.ns == "colliders")
       drawn.push_back(m);
-  ASSERT_EQ(drawn.size(), 5u);  // sphere, cylinder + 2 caps, cube
+  ASSERT_EQ(drawn.size(), 6u);  // sphere, cylinder + 2 caps, cube, mesh
   EXPECT_EQ(drawn[0].type, visualization_msgs::Marker::SPHERE);
   EXPECT_EQ(drawn[0].scale.x, 0.4);
   EXPECT_EQ(drawn[0].pose.position.x, 1.0);
@@ -145,6 +153,14 @@ TEST(RosConverter, CollidersAreDrawnInTheirCurrentPoseWithTheirExtents)
   EXPECT_NEAR(drawn[2].pose.position.x, -drawn[3].pose.position.x, 1e-12);
   EXPECT_EQ(drawn[4].type, visualization_msgs::Marker::CUBE);
   EXPECT_EQ(drawn[4].scale.y, 0.6);
+  // A mesh: its file at its scale, in the colliders' colour rather than the file's.
+  EXPECT_EQ(drawn[5].type, visualization_msgs::Marker::MESH_RESOURCE);
+  EXPECT_EQ(drawn[5].mesh_resource, "package://soft_body_sim/config/meshes/part.stl");
+  EXPECT_FALSE(drawn[5].mesh_use_embedded_materials);
+  EXPECT_EQ(drawn[5].scale.x, 2.0);
+  EXPECT_EQ(drawn[5].scale.z, 0.5);
+  EXPECT_EQ(drawn[5].pose.position.z, -3.0);
+  EXPECT_EQ(drawn[5].color.r, drawn[4].color.r);
   std::set<int> ids;
   for (const visualization_msgs::Marker& m : drawn)
   {

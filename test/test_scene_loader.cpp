@@ -2,11 +2,14 @@
 // a one-line message "<source>:<line>: <key path>: <reason>" that points at the offending value.
 #include "soft_body_sim/scene/scene_loader.h"
 #include "scene_error.h"
+#include "soft_body_sim/core/contact.h"
+#include "soft_body_sim/core/mesh_field.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <ostream>
@@ -1079,7 +1082,7 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
 {
   const std::string body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";
   expectSceneError("colliders: [{name: a, shape: cone, radius: 1}]\n" + body, "bad.yaml:1: colliders[0].shape",
-                   { "unknown shape 'cone'", "sphere, capsule, cylinder, box" });
+                   { "unknown shape 'cone'", "sphere, capsule, cylinder, box, mesh" });
   expectSceneError("colliders: [{name: a, shape: sphere, radius: 0}]\n" + body, "bad.yaml:1: colliders[0].radius",
                    { "> 0" });
   expectSceneError("colliders: [{name: a, shape: box, size: [1, 0, 1]}]\n" + body, "bad.yaml:1: colliders[0].size",
@@ -1103,6 +1106,75 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
   expectSceneError("bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1, "
                    "radius: -0.1}]\n",
                    "bad.yaml:1: bodies[0].radius", { "radius must be >= 0", "-0.1" });
+}
+
+TEST(SceneLoader, BadMeshCollidersAreRejectedWithOneLineAtTheKey)
+{
+  const std::string body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";
+  const std::string part = std::string("file://") + SOURCE_DIR + "/config/meshes/part.stl";
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: file:///nonexistent/part.stl}]\n" + body,
+                   "bad.yaml:1: colliders[0].mesh", { "'/nonexistent/part.stl'", "cannot be read" });
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: missing.stl}]\n" + body, "bad.yaml:1: colliders[0].mesh",
+                   { "'missing.stl'", "cannot be read" });  // relative to the scene's folder: none for "bad.yaml"
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: package://no_such_package_here/part.stl}]\n" + body,
+                   "bad.yaml:1: colliders[0].mesh", { "ROS package 'no_such_package_here'", "not found" });
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: http://example.com/part.stl}]\n" + body,
+                   "bad.yaml:1: colliders[0].mesh", { "only package://, file:// and plain paths" });
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", scale: [1, 0, 1]}]\n" + body,
+                   "bad.yaml:1: colliders[0].scale", { "every factor of scale must be > 0" });
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", scale: [1, 1, -1]}]\n" + body,
+                   "bad.yaml:1: colliders[0].scale", { "every factor of scale must be > 0" });
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", voxel_size: 0}]\n" + body,
+                   "bad.yaml:1: colliders[0].voxel_size", { "> 0" });
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", voxel_size: 0.00001}]\n" + body,
+                   "bad.yaml:1: colliders[0].voxel_size", { "voxels, more than the 16777216 allowed" });
+  expectSceneError("colliders: [{name: a, shape: mesh}]\n" + body, "bad.yaml:1: colliders[0].mesh",
+                   { "missing required key" });
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", size: [1, 1, 1]}]\n" + body,
+                   "bad.yaml:1: colliders[0].size", { "unknown key", "mesh, scale, voxel_size" });
+}
+
+// A mesh named by package://, file:// and a path relative to the scene file's folder is the same file;
+// its scale applies, and its field is built at load time, as wide as the thickest body needs.
+TEST(SceneLoader, MeshCollidersAreReadFromPackageFileAndRelativeURIs)
+{
+  // The package as `source devel/setup.bash` would put it on the path.
+  const char* previous = std::getenv("ROS_PACKAGE_PATH");
+  ::setenv("ROS_PACKAGE_PATH", (std::string(SOURCE_DIR) + (previous ? ":" + std::string(previous) : "")).c_str(), 1);
+  const SceneDef scene = parseScene(std::string(R"(colliders:
+  - {name: by_package, shape: mesh, mesh: package://soft_body_sim/config/meshes/part.stl, scale: [2, 1, 1]}
+  - {name: by_path, shape: mesh, mesh: ../meshes/part.stl, position: [1, 0, 0], voxel_size: 0.002, friction: 0.4}
+  - {name: by_file, shape: mesh, mesh: file://)") + SOURCE_DIR + R"(/config/meshes/part.stl}
+bodies:
+  - {name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1, radius: 0.03}
+)",
+                                    std::string(SOURCE_DIR) + "/config/scenes/meshes.yaml");
+  if (previous)
+    ::setenv("ROS_PACKAGE_PATH", previous, 1);
+  else
+    ::unsetenv("ROS_PACKAGE_PATH");
+  ASSERT_EQ(scene.colliders.meshes.size(), 3u);
+  for (const Mesh& mesh : scene.colliders.meshes)
+  {
+    SCOPED_TRACE(mesh.at.name);
+    ASSERT_TRUE(mesh.triangles);
+    EXPECT_EQ(mesh.triangles->triangles.size(), 20u);  // scripts/make_part_stl.py's bracket
+    ASSERT_TRUE(mesh.field);
+    EXPECT_GE(mesh.field->exteriorBand(), 0.03 + 2.0 * mesh.field->voxelSize());
+  }
+  const Mesh& scaled = scene.colliders.meshes[0];
+  EXPECT_EQ(scaled.uri, "package://soft_body_sim/config/meshes/part.stl");
+  EXPECT_NEAR((scaled.triangles->upper() - scaled.triangles->lower()).x(), 0.2, 1e-6);  // 10 cm, doubled
+  EXPECT_NEAR(scaled.field->voxelSize(), 0.2 / kDefaultVoxelsPerExtent, 1e-9);
+  EXPECT_NEAR((scene.colliders.meshes[1].triangles->upper() - scene.colliders.meshes[1].triangles->lower()).x(), 0.1,
+              1e-6);
+  EXPECT_EQ(scene.colliders.meshes[1].voxel_size, 0.002);
+  EXPECT_EQ(scene.colliders.meshes[1].at.friction, 0.4);
+  const World world = buildWorld(scene);
+  ASSERT_EQ(world.colliderPoses().size(), 3u);
+  EXPECT_EQ(world.colliderPoses()[0].shape, ColliderPose::Shape::Mesh);
+  EXPECT_EQ(world.colliderPoses()[0].mesh, "package://soft_body_sim/config/meshes/part.stl");
+  EXPECT_EQ(world.colliderPoses()[0].size, Vec3(2, 1, 1));
 }
 
 // --- files -------------------------------------------------------------------------------------

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "soft_body_sim/core/definition_error.h"
+#include "soft_body_sim/core/mesh_field.h"
 
 namespace soft_body_sim
 {
@@ -69,6 +70,26 @@ void checkCollider(const Cylinder& cylinder)
   requireDefinition(cylinder.length > 0.0 && std::isfinite(cylinder.length), "collider '" + cylinder.at.name + "'",
                     { "length" }, "length must be > 0");
 }
+
+void checkCollider(const Mesh& mesh)
+{
+  checkPlacement(mesh.at);
+  const std::string what = "collider '" + mesh.at.name + "'";
+  requireDefinition(mesh.scale.allFinite() && mesh.scale.minCoeff() > 0.0, what, { "scale" },
+                    "every factor of scale must be > 0");
+  requireDefinition(mesh.triangles && !mesh.triangles->triangles.empty(), what, { "mesh" },
+                    "no triangles were read from '" + mesh.uri + "'");
+  requireDefinition(mesh.voxel_size >= 0.0 && std::isfinite(mesh.voxel_size), what, { "voxel_size" },
+                    "voxel_size must be > 0 (or 0: the default, the largest extent / 100)");
+  const double voxel = mesh.voxel_size > 0.0 ? mesh.voxel_size : defaultVoxelSize(*mesh.triangles);
+  const double voxels = fieldVoxels(*mesh.triangles, voxel, 0.0);
+  requireDefinition(voxels <= kMaxFieldVoxels, what, { "voxel_size" },
+                    "voxel_size " + std::to_string(voxel) + " m spans the mesh's bounding box with " +
+                        std::to_string(static_cast<long long>(voxels)) + " voxels, more than the " +
+                        std::to_string(static_cast<long long>(kMaxFieldVoxels)) + " allowed; make it larger");
+}
+
+double boundingRadius(const Mesh& mesh) { return mesh.triangles ? mesh.triangles->boundingRadius() : 0.0; }
 
 SurfaceDistance surfaceDistance(const Sphere& sphere, const Eigen::Vector3d& local)
 {
@@ -140,6 +161,11 @@ SurfaceDistance surfaceDistance(const Cylinder& cylinder, const Eigen::Vector3d&
     s.closest = Eigen::Vector3d(local.x(), local.y(), half * axial.z());
   }
   return s;
+}
+
+SurfaceDistance surfaceDistance(const Mesh& mesh, const Eigen::Vector3d& local)
+{
+  return mesh.field->distance(local);
 }
 
 }  // namespace soft_body_sim

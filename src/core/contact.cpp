@@ -2,6 +2,7 @@
 
 #include "shape_contacts.h"
 #include "soft_body_sim/core/collisions.h"
+#include "soft_body_sim/core/mesh_field.h"
 
 namespace soft_body_sim
 {
@@ -24,6 +25,13 @@ std::vector<std::unique_ptr<ColliderKind>> makeColliderKinds(const Model& model)
   addShapes(kinds, model.colliders.capsules, model.nodeCount());
   addShapes(kinds, model.colliders.boxes, model.nodeCount());
   addShapes(kinds, model.colliders.cylinders, model.nodeCount());
+  if (!model.colliders.meshes.empty())
+  {
+    // Their distance fields reach as far out as the thickest node needs.
+    std::vector<Mesh> meshes = model.colliders.meshes;
+    buildMeshFields(meshes, model.nodeCount() > 0 ? model.contact_radius.maxCoeff() : 0.0);
+    addShapes(kinds, meshes, model.nodeCount());
+  }
   return kinds;
 }
 

@@ -1,5 +1,6 @@
 #include "soft_body_sim/core/scene_def.h"
 
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -31,6 +32,14 @@ int resolveNodeIndex(long long index, int node_count)
     throw std::out_of_range("node index " + std::to_string(index) + " out of range for " +
                             std::to_string(node_count) + " nodes");
   return static_cast<int>(resolved);
+}
+
+double maxContactRadius(const SceneDef& scene)
+{
+  double radius = 0.0;
+  for (const BodyDef& body : scene.bodies)
+    radius = std::max(radius, body.contact_radius);
+  return radius;
 }
 
 World buildWorld(const SceneDef& scene)

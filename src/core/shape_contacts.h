@@ -1,4 +1,4 @@
-// Contact with rigid shapes (spheres, capsules, boxes): one template over the shape, whose geometry is
+// Contact with rigid shapes (spheres, capsules, boxes, cylinders, meshes): one template over the shape, whose geometry is
 // surfaceDistance (colliders.h). Private to the core.
 #pragma once
 
@@ -10,6 +10,7 @@
 
 #include "contact_response.h"
 #include "soft_body_sim/core/contact.h"
+#include "soft_body_sim/core/mesh_field.h"
 
 namespace soft_body_sim
 {
@@ -57,6 +58,39 @@ inline double nearestParameter(const Capsule& capsule, const Vec3& la, const Vec
   else if (s > 1.0)
     t = std::clamp((b - c) / a, 0.0, 1.0);
   return t;
+}
+
+/// A mesh need not be convex, so the distance along a segment may have several minima: it is sampled at
+/// about a voxel apart (a minimum narrower than that is one the field cannot resolve anyway), then the
+/// best sample's neighbourhood is searched as above, to (2/3)^16 = 2e-3 of two sample spacings.
+inline double nearestParameter(const Mesh& mesh, const Vec3& la, const Vec3& d)
+{
+  const double voxel = mesh.field->voxelSize();
+  const int samples = std::clamp(static_cast<int>(std::ceil(d.norm() / voxel)), 4, 256);
+  int best = 0;
+  double nearest = surfaceDistance(mesh, la).distance;
+  for (int k = 1; k <= samples; ++k)
+  {
+    const double distance = surfaceDistance(mesh, la + (static_cast<double>(k) / samples) * d).distance;
+    if (distance < nearest)
+    {
+      nearest = distance;
+      best = k;
+    }
+  }
+  double lo = std::max(0, best - 1) / static_cast<double>(samples);
+  double hi = std::min(samples, best + 1) / static_cast<double>(samples);
+  for (int iteration = 0; iteration < 16; ++iteration)
+  {
+    const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
+    if (surfaceDistance(mesh, la + m1 * d).distance < surfaceDistance(mesh, la + m2 * d).distance)
+      hi = m2;
+    else
+      lo = m1;
+  }
+  // Two minima in the bracket can mislead the search: it never returns worse than the best sample.
+  const double t = 0.5 * (lo + hi);
+  return surfaceDistance(mesh, la + t * d).distance <= nearest ? t : best / static_cast<double>(samples);
 }
 
 /// The most a segment contact moves either node per unit of the contact point's correction.

@@ -6,6 +6,10 @@
 
 #include <urdf/model.h>
 
+#include "soft_body_sim/core/definition_error.h"
+#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/scene/mesh_uri.h"
+
 namespace soft_body_sim
 {
 void addRobotColliders(const std::string& urdf_xml, const RobotCollidersDef& robot, Colliders& colliders,
@@ -45,9 +49,31 @@ void addRobotColliders(const std::string& urdf_xml, const RobotCollidersDef& rob
         colliders.spheres.push_back(Sphere{ at, sphere->radius });
       else if (const auto cylinder = std::dynamic_pointer_cast<urdf::Cylinder>(geometry))
         colliders.cylinders.push_back(Cylinder{ at, cylinder->radius, cylinder->length });
+      else if (const auto file = std::dynamic_pointer_cast<urdf::Mesh>(geometry))
+      {
+        Mesh mesh;
+        mesh.at = at;
+        mesh.uri = file->filename;
+        mesh.scale = Vec3(file->scale.x, file->scale.y, file->scale.z);
+        try
+        {
+          // A URDF's relative mesh paths have no folder to be relative to: the working directory's.
+          if (!(mesh.scale.minCoeff() > 0.0))
+            throw std::invalid_argument("scale " + std::to_string(mesh.scale.x()) + " " +
+                                        std::to_string(mesh.scale.y()) + " " + std::to_string(mesh.scale.z()) +
+                                        " is not > 0 in every axis");
+          mesh.triangles = std::make_shared<const TriangleMesh>(readTriangleMesh(resolveMeshUri(mesh.uri, ""), mesh.scale));
+        }
+        catch (const std::invalid_argument& e)
+        {
+          skipped.push_back(at.name + " (mesh '" + mesh.uri + "': " + e.what() + ")");
+          continue;
+        }
+        colliders.meshes.push_back(mesh);
+      }
       else
       {
-        skipped.push_back(at.name + " (a mesh: not supported yet)");
+        skipped.push_back(at.name + " (an unknown geometry)");
         continue;
       }
       ++added;
@@ -55,7 +81,7 @@ void addRobotColliders(const std::string& urdf_xml, const RobotCollidersDef& rob
   }
   if (added == 0)
     throw std::invalid_argument("robot_colliders: the URDF '" + model.getName() + "' on '" + robot.param +
-                                "' has no box, sphere or cylinder <collision>");
+                                "' has no box, sphere, cylinder or readable mesh <collision>");
 }
 
 }  // namespace soft_body_sim

@@ -69,8 +69,9 @@ geometry_msgs::Pose pose(const Vec3& position, const Eigen::Quaterniond& orienta
   return out;
 }
 
-/// Namespace "colliders": per collider k, id 3k its solid (SPHERE, CYLINDER or CUBE in its pose); a
-/// capsule adds its two end caps as SPHEREs, ids 3k + 1 and 3k + 2.
+/// Namespace "colliders": per collider k, id 3k its solid (SPHERE, CYLINDER, CUBE, or a MESH_RESOURCE of
+/// the mesh's file at its scale, in its pose); a capsule adds its two end caps as SPHEREs, ids 3k + 1 and
+/// 3k + 2.
 void addColliderMarkers(const World& world, const std::string& frame_id, const ros::Time& stamp,
                         visualization_msgs::MarkerArray& array)
 {
@@ -84,7 +85,14 @@ void addColliderMarkers(const World& world, const std::string& frame_id, const r
       type = visualization_msgs::Marker::CYLINDER;
     else if (c.shape == ColliderPose::Shape::Box)
       type = visualization_msgs::Marker::CUBE;
+    else if (c.shape == ColliderPose::Shape::Mesh)
+      type = visualization_msgs::Marker::MESH_RESOURCE;
     visualization_msgs::Marker solid = marker(frame_id, stamp, "colliders", id, type, 1.0, colliderColor());
+    if (c.shape == ColliderPose::Shape::Mesh)
+    {
+      solid.mesh_resource = c.mesh;
+      solid.mesh_use_embedded_materials = false;  // the colliders' grey, as the other shapes
+    }
     solid.pose = pose(c.position, c.orientation);
     solid.scale.x = c.size.x();
     solid.scale.y = c.size.y();

@@ -5,6 +5,7 @@
 #include <std_msgs/Time.h>
 
 #include "soft_body_sim/SimState.h"
+#include "soft_body_sim/core/mesh_field.h"
 #include "soft_body_sim/ros/robot_colliders.h"
 #include "soft_body_sim/scene/scene_loader.h"
 
@@ -85,6 +86,8 @@ void SimNode::addRobotColliders()
   }
   for (const std::string& collision : skipped)
     ROS_WARN("%s: robot collision %s left out", name_.c_str(), collision.c_str());
+  // The robot's meshes get their fields once here, as the scene's own did at load time: a reset reuses them.
+  buildMeshFields(scene_.colliders.meshes, maxContactRadius(scene_));
 }
 
 void SimNode::buildWorldFromScene()

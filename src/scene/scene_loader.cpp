@@ -9,6 +9,8 @@
 #include <utility>
 
 #include "body_readers.h"
+#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/scene/mesh_uri.h"
 #include "yaml_reader.h"
 
 namespace soft_body_sim
@@ -178,6 +180,43 @@ Shape readRadiusAndLength(const Context& ctx, const Field& field)
   return shape;
 }
 
+/// A mesh: its file resolved (package://, file://, or a path relative to the scene file's folder) and read
+/// with its scale; a file that cannot be read fails at `mesh` with the path and the reason.
+Mesh readMesh(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, withPlacementKeys({ "mesh", "scale", "voxel_size" }));
+  Mesh mesh;
+  mesh.at = readPlacement(ctx, field);
+  const Field uri = requiredKey(ctx, field, "mesh");
+  mesh.uri = readNonEmptyString(ctx, uri);
+  if (const std::optional<Field> value = optionalKey(field, "scale"))
+    mesh.scale = readVec3(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "voxel_size"))
+    mesh.voxel_size = readPositive(ctx, *value);
+  if (!(mesh.scale.minCoeff() > 0.0))
+    return mesh;  // checkCollider says so at `scale`; the file is not read at a scale that makes no solid
+  const std::size_t slash = ctx.source().rfind('/');
+  const std::string folder = slash == std::string::npos ? std::string() : ctx.source().substr(0, slash);
+  std::string path;
+  try
+  {
+    path = resolveMeshUri(mesh.uri, folder);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    ctx.fail(uri, e.what());
+  }
+  try
+  {
+    mesh.triangles = std::make_shared<const TriangleMesh>(readTriangleMesh(path, mesh.scale));
+  }
+  catch (const DefinitionError& e)
+  {
+    ctx.fail(uri, e.what());
+  }
+  return mesh;
+}
+
 /// One item of `colliders:`, added to `colliders` by its shape.
 void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
 {
@@ -208,9 +247,13 @@ void readCollider(const Context& ctx, const Field& field, Colliders& colliders)
     box.size = readVec3(ctx, requiredKey(ctx, field, "size"));
     addChecked(ctx, field, box, colliders.boxes);
   }
+  else if (name == "mesh")
+  {
+    addChecked(ctx, field, readMesh(ctx, field), colliders.meshes);
+  }
   else
   {
-    ctx.fail(shape, "unknown shape " + quoted(name) + "; valid shapes: sphere, capsule, cylinder, box");
+    ctx.fail(shape, "unknown shape " + quoted(name) + "; valid shapes: sphere, capsule, cylinder, box, mesh");
   }
 }
 
@@ -317,6 +360,9 @@ SceneDef readScene(const Context& ctx, const Field& root)
   }
   if (scene.bodies.empty())
     ctx.fail(bodies, "must not be empty; a scene needs at least one body");
+  // Built once here, as wide as the thickest body needs: every world built from the scene (a reset too)
+  // shares them.
+  buildMeshFields(scene.colliders.meshes, maxContactRadius(scene));
   return scene;
 }
 

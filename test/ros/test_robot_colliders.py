@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""Colliders from a URDF (launched by robot_colliders.test): the table, post and knob of test_robot.urdf
-follow their links as robot_state_publisher moves them; a rope dropped onto the table rests on its top;
-the table's marker follows the prismatic joint."""
+"""Colliders from a URDF (launched by robot_colliders.test): the table, post, knob and bracket (a mesh) of
+test_robot.urdf follow their links as robot_state_publisher moves them; a rope dropped onto the table
+rests on its top; the table's and the bracket's markers follow the prismatic joint."""
 import threading
 
 import rospy
@@ -42,14 +42,14 @@ class RobotCollidersTest(NodeTestCase):
         cls.joints.publish(message)
 
     def shapes(self):
-        """The latest collider markers by type: CUBE, CYLINDER, SPHERE."""
+        """The latest collider markers by type: CUBE, CYLINDER, SPHERE, MESH_RESOURCE."""
         latest = self.markers[-1] if self.markers else []
         return {m.type: m for m in latest}
 
     def test_1_the_rope_drapes_on_the_table_and_the_markers_follow_the_joint(self):
         # Every collision of the URDF is drawn once robot_state_publisher's tf arrives. The rope fell
         # through before that (the node simulates from its start); ~reset drops it again, onto the table.
-        self.assertTrue(wait_for(lambda: len(self.shapes()) == 3, 20.0), self.shapes())
+        self.assertTrue(wait_for(lambda: len(self.shapes()) == 4, 20.0), self.shapes())
         rospy.wait_for_service(NODE + "/reset", 10.0)
         rospy.ServiceProxy(NODE + "/reset", Empty)()
         # Dropped 0.15 m, the rope lies on the table's top within a few seconds: no node below it, the
@@ -69,6 +69,10 @@ class RobotCollidersTest(NodeTestCase):
         self.assertAlmostEqual(post.pose.position.z, 0.35, delta=1e-3)
         knob = self.shapes()[2]  # 2 = SPHERE
         self.assertAlmostEqual(knob.pose.position.z, 0.48, delta=1e-3)
+        bracket = self.shapes()[10]  # 10 = MESH_RESOURCE: the bracket, on the table at x = -0.2 + 0.1
+        self.assertEqual(bracket.mesh_resource, "package://soft_body_sim/config/meshes/part.stl")
+        self.assertAlmostEqual(bracket.pose.position.x, -0.1, delta=1e-3)
+        self.assertAlmostEqual(bracket.scale.x, 1.0)
 
 
 if __name__ == "__main__":

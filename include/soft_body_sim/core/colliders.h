@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -68,6 +69,22 @@ struct Box
   Eigen::Vector3d size = Eigen::Vector3d::Constant(0.1);  ///< [m], each > 0
 };
 
+struct TriangleMesh;
+class MeshField;
+
+/// A rigid triangle mesh read from a file (mesh_field.h), in its local frame: the file's coordinates
+/// times `scale`. It must be closed (watertight) for inside and outside to mean something. Contact
+/// queries its signed distance field, built when the world is built.
+struct Mesh
+{
+  ColliderPlacement at;
+  std::string uri;  ///< the file as the scene names it (`mesh`: package://, file:// or a path), for drawing
+  Eigen::Vector3d scale = Eigen::Vector3d::Ones();  ///< per local axis [-], each > 0
+  double voxel_size = 0.0;  ///< [m] edge of the distance field's voxels, > 0; 0 = defaultVoxelSize
+  std::shared_ptr<const TriangleMesh> triangles;  ///< readTriangleMesh of the file, scale applied
+  std::shared_ptr<const MeshField> field;  ///< built from `triangles` by buildMeshFields (makeColliderKinds)
+};
+
 /// Every collider of a scene, by kind. A scene without any has no contact stage at all.
 struct Colliders
 {
@@ -76,9 +93,11 @@ struct Colliders
   std::vector<Capsule> capsules;
   std::vector<Box> boxes;
   std::vector<Cylinder> cylinders;
+  std::vector<Mesh> meshes;
 };
 
-/// Every shape's placement, in the order of Colliders' vectors (spheres, capsules, boxes, cylinders): for the
+/// Every shape's placement, in the order of Colliders' vectors (spheres, capsules, boxes, cylinders,
+/// meshes): for the
 /// callers that treat all shapes alike (which follow a tf frame).
 inline std::vector<const ColliderPlacement*> placements(const Colliders& colliders)
 {
@@ -91,16 +110,21 @@ inline std::vector<const ColliderPlacement*> placements(const Colliders& collide
     all.push_back(&b.at);
   for (const Cylinder& c : colliders.cylinders)
     all.push_back(&c.at);
+  for (const Mesh& m : colliders.meshes)
+    all.push_back(&m.at);
   return all;
 }
 
 /// Checks a collider as a scene declares it: a finite pose and motion, a non-zero orientation (any
 /// length: it is normalised where it is used), friction >= 0, restitution in [0, 1] and positive
-/// extents (a capsule's length may be 0). Throws DefinitionError naming the keys at fault.
+/// extents (a capsule's length may be 0); a mesh: its triangles read, a positive scale, a voxel_size >= 0
+/// that spans its bounding box with at most kMaxFieldVoxels (mesh_field.h). Throws DefinitionError naming
+/// the keys at fault.
 void checkCollider(const Sphere& sphere);
 void checkCollider(const Capsule& capsule);
 void checkCollider(const Box& box);
 void checkCollider(const Cylinder& cylinder);
+void checkCollider(const Mesh& mesh);
 
 /// The nearest point of a shape's surface to a point, in the shape's local frame.
 struct SurfaceDistance
@@ -116,11 +140,14 @@ SurfaceDistance surfaceDistance(const Sphere& sphere, const Eigen::Vector3d& loc
 SurfaceDistance surfaceDistance(const Capsule& capsule, const Eigen::Vector3d& local);
 SurfaceDistance surfaceDistance(const Box& box, const Eigen::Vector3d& local);
 SurfaceDistance surfaceDistance(const Cylinder& cylinder, const Eigen::Vector3d& local);
+/// A mesh's from its distance field (MeshField::distance, which states its accuracy); needs `field`.
+SurfaceDistance surfaceDistance(const Mesh& mesh, const Eigen::Vector3d& local);
 
 /// The radius [m] of a ball about the shape's origin that holds it.
 inline double boundingRadius(const Sphere& sphere) { return sphere.radius; }
 inline double boundingRadius(const Capsule& capsule) { return 0.5 * capsule.length + capsule.radius; }
 inline double boundingRadius(const Box& box) { return 0.5 * box.size.norm(); }
 inline double boundingRadius(const Cylinder& c) { return std::hypot(c.radius, 0.5 * c.length); }
+double boundingRadius(const Mesh& mesh);
 
 }  // namespace soft_body_sim

@@ -24,25 +24,29 @@ struct ColliderPose
     Sphere,
     Capsule,
     Box,
-    Cylinder
+    Cylinder,
+    Mesh
   };
   std::string name;
   Shape shape = Shape::Sphere;
   Vec3 position = Vec3::Zero();                                   ///< [m] of its origin
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
-  /// [m] sphere: its diameter three times; capsule and cylinder: (2 radius, 2 radius, length); box: its size.
+  /// [m] sphere: its diameter three times; capsule and cylinder: (2 radius, 2 radius, length); box: its size;
+  /// mesh: its scale [-] (the file's coordinates are metres).
   Vec3 size = Vec3::Zero();
+  std::string mesh;  ///< a mesh's file as the scene names it (package://, file:// or a path); else empty
 
-  static ColliderPose of(const Sphere& s) { return { s.at.name, Shape::Sphere, s.at.position, s.at.orientation, Vec3::Constant(2.0 * s.radius) }; }
+  static ColliderPose of(const Sphere& s) { return { s.at.name, Shape::Sphere, s.at.position, s.at.orientation, Vec3::Constant(2.0 * s.radius), {} }; }
   static ColliderPose of(const Capsule& c)
   {
-    return { c.at.name, Shape::Capsule, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length) };
+    return { c.at.name, Shape::Capsule, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {} };
   }
-  static ColliderPose of(const Box& b) { return { b.at.name, Shape::Box, b.at.position, b.at.orientation, b.size }; }
+  static ColliderPose of(const Box& b) { return { b.at.name, Shape::Box, b.at.position, b.at.orientation, b.size, {} }; }
   static ColliderPose of(const Cylinder& c)
   {
-    return { c.at.name, Shape::Cylinder, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length) };
+    return { c.at.name, Shape::Cylinder, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {} };
   }
+  static ColliderPose of(const Mesh& m) { return { m.at.name, Shape::Mesh, m.at.position, m.at.orientation, m.scale, m.uri }; }
 };
 
 /// A rigid pose: position [m] and orientation (unit quaternion) of a collider's origin and axes.

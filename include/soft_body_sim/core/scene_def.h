@@ -122,6 +122,10 @@ constexpr long long kMaxSceneNodes = 1000000;
 /// (-1 is the last node). Throws std::out_of_range if it is outside the body.
 int resolveNodeIndex(long long index, int node_count);
 
+/// The largest contact radius [m] of the scene's bodies (0 without any): how far outside a mesh collider's
+/// distance field must reach (buildMeshFields).
+double maxContactRadius(const SceneDef& scene);
+
 /// Flattens the bodies into one node array (body k's nodes follow body k-1's), pins anchored nodes,
 /// makes the controllers and returns the world. Expects a valid scene (the loader checks); throws
 /// std::invalid_argument on an index out of range, a bad collider (a zero plane normal), a zero cell

@@ -1,0 +1,43 @@
+#include "soft_body_sim/scene/mesh_uri.h"
+
+#include <cstdlib>
+#include <stdexcept>
+
+#include <ros/package.h>
+
+namespace soft_body_sim
+{
+namespace
+{
+bool startsWith(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
+}  // namespace
+
+std::string resolveMeshUri(const std::string& uri, const std::string& base_directory)
+{
+  const std::string package_scheme = "package://", file_scheme = "file://";
+  if (startsWith(uri, package_scheme))
+  {
+    const std::string rest = uri.substr(package_scheme.size());
+    const std::size_t slash = rest.find('/');
+    const std::string package = rest.substr(0, slash);
+    if (package.empty() || slash == std::string::npos || slash + 1 == rest.size())
+      throw std::invalid_argument("'" + uri + "' is not package://PACKAGE/PATH");
+    const std::string folder = ros::package::getPath(package);
+    if (folder.empty())
+    {
+      const char* search = std::getenv("ROS_PACKAGE_PATH");
+      throw std::invalid_argument("ROS package '" + package + "' of '" + uri + "' not found on ROS_PACKAGE_PATH (" +
+                                  (search ? search : "unset") + ")");
+    }
+    return folder + rest.substr(slash);
+  }
+  if (startsWith(uri, file_scheme))
+    return uri.substr(file_scheme.size());
+  if (uri.find("://") != std::string::npos)
+    throw std::invalid_argument("'" + uri + "': only package://, file:// and plain paths are meshes");
+  if (uri.empty() || uri.front() == '/' || base_directory.empty())
+    return uri;
+  return base_directory + "/" + uri;
+}
+
+}  // namespace soft_body_sim
