@@ -6,6 +6,7 @@
 // Cloths of 100 to 100,000 nodes (BM_ClothStep/<integrator>/<nodes>) give the cost per spring update
 // (items = spring updates) and how the step cost grows with the node count (scripts/bench fits the
 // log-log slope); BM_ClothSpringForces is the force kernel alone on the 10,000-node cloth.
+// BM_StiffRopeImplicitEuler/<nodes>: implicit Euler's direct solve on a stiff rope, 100 to 100,000 nodes.
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
 // capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
@@ -107,6 +108,30 @@ void BM_ClothSpringForces(benchmark::State& bench)
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.springs.size()));
 }
 
+/// The stiff hanging rope of issue 16 at a ROS node's step: `nodes` nodes over 1 m, 0.1 kg, springs of
+/// 1e6 N/m, pinned at one end, implicit_euler at dt = 1/60 s with one Newton iteration. items = nodes
+/// per step: the cost per node shows whether the step is linear in the rope's length.
+void BM_StiffRopeImplicitEuler(benchmark::State& bench)
+{
+  RopeDef rope;
+  rope.nodes = static_cast<int>(bench.range(0));
+  rope.mass = 0.1;
+  rope.stiffness = 1e6;
+  rope.pinned = { 0 };
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 1, 1 };
+  scene.bodies.push_back(buildRope("rope", rope));
+  World world = buildWorld(scene);
+  world.step();  // the pattern is analysed on the first step
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(rope.nodes));
+}
+
 enum class Shape
 {
   Sphere,
@@ -197,6 +222,7 @@ BENCHMARK_CAPTURE(BM_ClothStep, semi_implicit_euler, IntegratorType::SemiImplici
 BENCHMARK_CAPTURE(BM_ClothStep, xpbd, IntegratorType::Xpbd)->Apply(clothSizes);
 BENCHMARK_CAPTURE(BM_ClothStep, implicit_euler, IntegratorType::ImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000);
 BENCHMARK(BM_ClothSpringForces)->Arg(10000);
+BENCHMARK(BM_StiffRopeImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000);
 BENCHMARK_CAPTURE(BM_RopeOnColliders, sphere, Shape::Sphere)->Args({ 1000, 0 })->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, capsule, Shape::Capsule)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, box, Shape::Box)->Args({ 1000, 10 });
