@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <Eigen/LU>
 #include <limits>
 #include <utility>
@@ -19,9 +20,10 @@ using Matrix3 = Eigen::Matrix3d;
 /// solved by Newton's method as in Baraff & Witkin 1998 ("Large steps in cloth simulation"):
 /// each iteration linearises f about (x_lin, v_k) and solves
 ///   (M - h D - h^2 K) dv = h f(x_lin, v_k) + h K (x_n + h v_k - x_lin) - M (v_k - v_n)
-/// with K = df/dx, D = df/dv, directly, by a sparse LDL^T factorisation (SparseBlockSolver): on a rope
-/// its cost is linear in the nodes, where conjugate gradients needed hundreds of sweeps on a stiff,
-/// light chain (condition number ~ k h^2 / m). The first iteration linearises at
+/// with K = df/dx, D = df/dv, directly by a sparse LDL^T factorisation (SparseBlockSolver) or by
+/// preconditioned conjugate gradients, whichever costs less (see solve): on a rope the direct solve is
+/// linear in the nodes, where conjugate gradients needed hundreds of sweeps on a stiff, light chain
+/// (condition number ~ k h^2 / m). The first iteration linearises at
 /// x_lin = x_n (exactly Baraff & Witkin's step); later ones at x_lin = x_n + h v_k.
 /// K's transverse term k (1 - L/l)(I - u u^T) is dropped when the spring is compressed (Choi & Ko
 /// 2002) so that the matrix stays symmetric positive definite; the damping force's dependence on x is
@@ -115,6 +117,7 @@ private:
       d = (m * (1.0 + h * model.drag)) * Matrix3::Identity();
     }
     springs_.resize(model.springs.size());
+    condition_ = 1.0;
     for (std::size_t k = 0; k < model.springs.size(); ++k)
     {
       const Spring& s = model.springs[k];
@@ -133,6 +136,10 @@ private:
       block.b = h * h * s.stiffness * transverse;
       const Matrix3 diagonal = h * h * stiffness + h * s.damping * uu;
       const Vec3 k_offset = -stiffness * (offset_.col(s.a) - offset_.col(s.b));
+      // The preconditioned A's largest eigenvalue over its smallest is about 1 + 4 (h^2 k + h c) / m
+      // for the stiffest spring on its lightest free end (a chain's: (m + 4 h^2 k) / m).
+      const double lightest = std::max(model.inverse_mass[s.a], model.inverse_mass[s.b]);
+      condition_ = std::max(condition_, 1.0 + 4.0 * (h * h * s.stiffness + h * s.damping) * lightest);
       const bool a_free = model.isFree(s.a);
       const bool b_free = model.isFree(s.b);
       if (a_free)
@@ -296,17 +303,18 @@ private:
           pairs.emplace_back(a, b);
         }
       }
-    direct_ = solver_.analyze(model.nodeCount(), pairs, kMaxDirectWork);
+    factorable_ = solver_.analyze(model.nodeCount(), pairs, kMaxFactorWork);
     analyzed_ = true;
   }
 
   /// delta_v_ = A^-1 rhs_: directly, A written from the blocks of assemble into the analysed pattern, or
-  /// by conjugate gradients where the factorisation would cost more (see kMaxDirectWork).
+  /// by conjugate gradients where they cost less (see kCgSweepsPerRootCondition).
   void solve(const Model& model)
   {
     if (!analyzed_)
       analyze(model);
-    if (!direct_)
+    const double work_per_entry = solver_.factorWork() / solver_.matrixEntries();
+    if (!factorable_ || work_per_entry > kCgSweepsPerRootCondition * std::sqrt(condition_))
     {
       buildPreconditioner(model);
       solveIteratively(model);
@@ -343,14 +351,19 @@ private:
       delta_v_.setConstant(3, model.nodeCount(), std::numeric_limits<double>::quiet_NaN());
   }
 
-  /// The direct solve is used while a factorisation costs at most this many multiply-adds per entry of
-  /// A (a product A p costs one). Measured (docs/RESULTS.md, implicit_euler at dt = 1/60 s, one Newton
-  /// iteration): on every rope the factor has no fill (2.9 per entry) and the direct solve wins at every
-  /// size (1000 nodes, k = 1e6 N/m: 0.3 ms against 41 ms); on a cloth the fill grows with the node count
-  /// (190 per entry at 1,000 nodes, 770 at 10,000, 1,600 at 30,000) and the two cost the same within a
-  /// factor 1.3 from 1,000 to 30,000 nodes, while at 100,000 nodes conjugate gradients are 4 times faster
-  /// (5 s against 21 s a step) and need 7 times less memory.
-  static constexpr double kMaxDirectWork = 500.0;
+  /// Which solve is cheaper. A conjugate-gradient sweep costs one multiply-add per entry of A, and to a
+  /// relative residual of 1e-12 CG takes about ln(2e12) / 2 = 14 sweeps per square root of the
+  /// preconditioned condition number (condition_); a factorisation costs its work per entry. So the
+  /// direct path is taken while work per entry <= 14 sqrt(condition). On a rope the factor has no fill
+  /// (2.9 per entry) and a stiff rope is badly conditioned (k = 1e6 N/m, 1 g nodes, dt = 1/60 s:
+  /// ~1e6): always direct, and linear in the length. On a cloth the fill grows with the node count
+  /// (190 per entry at 1,000 nodes, 770 at 10,000), and at small steps the mass dominates the matrix
+  /// and CG needs few sweeps. Measured (README): the rule picks the faster path or one within a factor
+  /// 1.3 of it.
+  static constexpr double kCgSweepsPerRootCondition = 14.0;
+  /// No factorisation is even prepared beyond this work per entry (a 100,000-node cloth would need
+  /// 0.75 GB for its factor).
+  static constexpr double kMaxFactorWork = 2000.0;
 
   /// The six pairs of a cell's four corners.
   static constexpr std::array<std::pair<int, int>, 6> kCellPairs{ { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } } };
@@ -364,7 +377,8 @@ private:
   std::vector<CellBlock> cells_;
   SparseBlockSolver solver_;
   bool analyzed_ = false;          ///< solver_ holds the pattern of the current model
-  bool direct_ = true;             ///< solve directly (else by conjugate gradients), see kMaxDirectWork
+  bool factorable_ = true;         ///< the pattern is prepared for the direct solve (see kMaxFactorWork)
+  double condition_ = 1.0;         ///< estimate of block-Jacobi preconditioned A's condition number
   std::vector<int> spring_slot_;   ///< per spring: its slot in solver_, or -1 (not coupled)
   std::vector<int> cell_slot_;     ///< per cell, six: each corner pair's slot, or -1
   ConstraintPass constraints_;
