@@ -14,14 +14,12 @@
 
 namespace soft_body_sim
 {
-/// Where along the segment la + t d (t in [0, 1], in the shape's local frame) the shape is nearest: the
-/// distance to a convex shape along a line is convex, so a ternary search finds it, to (2/3)^24 = 6e-5 of
-/// the link (3 um of a 5 cm link). Spheres and capsules have closed forms below.
+/// The t in [lo, hi] where the shape is nearest to la + t d, by a ternary search of `iterations` steps
+/// (the bracket shrinks by 2/3 each): exact where the distance along the line is convex in the bracket.
 template <typename Shape>
-double nearestParameter(const Shape& shape, const Vec3& la, const Vec3& d)
+double ternarySearch(const Shape& shape, const Vec3& la, const Vec3& d, double lo, double hi, int iterations)
 {
-  double lo = 0.0, hi = 1.0;
-  for (int iteration = 0; iteration < 24; ++iteration)
+  for (int iteration = 0; iteration < iterations; ++iteration)
   {
     const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
     if (surfaceDistance(shape, la + m1 * d).distance < surfaceDistance(shape, la + m2 * d).distance)
@@ -30,6 +28,15 @@ double nearestParameter(const Shape& shape, const Vec3& la, const Vec3& d)
       lo = m1;
   }
   return 0.5 * (lo + hi);
+}
+
+/// Where along the segment la + t d (t in [0, 1], in the shape's local frame) the shape is nearest: the
+/// distance to a convex shape along a line is convex, so a ternary search finds it, to (2/3)^24 = 6e-5 of
+/// the link (3 um of a 5 cm link). Spheres and capsules have closed forms below.
+template <typename Shape>
+double nearestParameter(const Shape& shape, const Vec3& la, const Vec3& d)
+{
+  return ternarySearch(shape, la, d, 0.0, 1.0, 24);
 }
 
 /// A sphere is nearest where its centre is.
@@ -78,18 +85,10 @@ inline double nearestParameter(const Mesh& mesh, const Vec3& la, const Vec3& d)
       best = k;
     }
   }
-  double lo = std::max(0, best - 1) / static_cast<double>(samples);
-  double hi = std::min(samples, best + 1) / static_cast<double>(samples);
-  for (int iteration = 0; iteration < 16; ++iteration)
-  {
-    const double m1 = lo + (hi - lo) / 3.0, m2 = hi - (hi - lo) / 3.0;
-    if (surfaceDistance(mesh, la + m1 * d).distance < surfaceDistance(mesh, la + m2 * d).distance)
-      hi = m2;
-    else
-      lo = m1;
-  }
+  const double lo = std::max(0, best - 1) / static_cast<double>(samples);
+  const double hi = std::min(samples, best + 1) / static_cast<double>(samples);
   // Two minima in the bracket can mislead the search: it never returns worse than the best sample.
-  const double t = 0.5 * (lo + hi);
+  const double t = ternarySearch(mesh, la, d, lo, hi, 16);
   return surfaceDistance(mesh, la + t * d).distance <= nearest ? t : best / static_cast<double>(samples);
 }
 
