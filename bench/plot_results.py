@@ -129,7 +129,7 @@ def scaling(out):
         return {}, {}
     with open(path) as f:
         benchmarks = json.load(f)["benchmarks"]
-    series, per_spring = {}, {}
+    series, per_spring, rope = {}, {}, []
     for b in benchmarks:
         name = b["name"]
         if name.startswith("BM_ClothStep/"):
@@ -138,6 +138,9 @@ def scaling(out):
             series.setdefault(integrator, []).append((b["nodes"], cpu_ns, b["springs"]))
         if name.startswith("BM_ClothSpringForces/"):
             per_spring["spring force kernel (accumulateSpringForces)"] = 1e9 / b["items_per_second"]
+        if name.startswith("BM_StiffRopeImplicitEuler/"):
+            cpu_ns = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6, "s": 1e9}[b["time_unit"]]
+            rope.append((int(name.split("/")[1]), cpu_ns))
     slopes = {}
     figure, axis = plt.subplots(figsize=(6.4, 4.6))
     for integrator, points in sorted(series.items()):
@@ -151,11 +154,21 @@ def scaling(out):
                 per_spring["%s step, per spring" % integrator] = p[1] / p[2]
         color, marker = STYLE.get(integrator, ("black", "o"))
         axis.plot(nodes, cost, color=color, marker=marker, label="%s: slope %.3f" % (integrator, slope))
+    if rope:
+        # implicit_euler's direct solve on the stiff rope (1e6 N/m, dt = 1/60 s, one Newton iteration).
+        rope.sort()
+        nodes = [p[0] for p in rope]
+        cost = [p[1] * 1e-9 for p in rope]
+        slope = fit_slope(nodes, cost)
+        slopes["implicit_euler, stiff rope"] = slope
+        color, _ = STYLE.get("implicit_euler", ("black", "o"))
+        axis.plot(nodes, cost, color=color, marker="s", linestyle="--",
+                  label="implicit_euler, stiff rope at 1/60 s: slope %.3f" % slope)
     axis.set_xscale("log")
     axis.set_yscale("log")
-    axis.set_xlabel("cloth nodes")
+    axis.set_xlabel("nodes")
     axis.set_ylabel("CPU s per step")
-    axis.set_title("Step cost against node count (cloth, Google Benchmark)")
+    axis.set_title("Step cost against node count (cloths; a stiff rope dashed)")
     axis.grid(True, which="major", linewidth=0.3)
     axis.legend(fontsize=9)
     figure.tight_layout()
