@@ -1,10 +1,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <Eigen/LU>
 #include <limits>
 #include <utility>
 #include <vector>
+
+#include <Eigen/LU>
 
 #include "integrator_kit.h"
 #include "sparse_block_solver.h"
@@ -137,7 +138,8 @@ private:
       const Matrix3 diagonal = h * h * stiffness + h * s.damping * uu;
       const Vec3 k_offset = -stiffness * (offset_.col(s.a) - offset_.col(s.b));
       // The preconditioned A's largest eigenvalue over its smallest is about 1 + 4 (h^2 k + h c) / m
-      // for the stiffest spring on its lightest free end (a chain's: (m + 4 h^2 k) / m).
+      // for the stiffest spring on its lightest free end (a chain's: (m + 4 h^2 k) / m). Springs only:
+      // a jelly's stiff cells are left out, which can only make the direct path look dearer than it is.
       const double lightest = std::max(model.inverse_mass[s.a], model.inverse_mass[s.b]);
       condition_ = std::max(condition_, 1.0 + 4.0 * (h * h * s.stiffness + h * s.damping) * lightest);
       const bool a_free = model.isFree(s.a);
@@ -278,7 +280,7 @@ private:
   static constexpr double kTolerance = 1e-12;
 
   /// The node pairs whose blocks of A may be non-zero, one slot each: every spring with both ends free,
-  /// then every pair of free corners of every cell (six per cell, in cellPairs' order).
+  /// then every pair of free corners of every cell (six per cell, in kCellPairs' order).
   void analyze(const Model& model)
   {
     std::vector<std::pair<int, int>> pairs;
