@@ -1134,7 +1134,8 @@ TEST(SceneLoader, BadMeshCollidersAreRejectedWithOneLineAtTheKey)
                    "bad.yaml:1: colliders[0].size", { "unknown key", "mesh, scale, voxel_size" });
 }
 
-// A mesh named by package://, file:// and a path relative to the scene file's folder is the same file;
+// A mesh named by package://, file:// and a path relative to the scene file's folder is the same file
+// (drawn by a URI rviz can load);
 // its scale applies, and its field is built at load time, as wide as the thickest body needs.
 TEST(SceneLoader, MeshCollidersAreReadFromPackageFileAndRelativeURIs)
 {
@@ -1169,6 +1170,8 @@ bodies:
   EXPECT_NEAR((scene.colliders.meshes[1].triangles->upper() - scene.colliders.meshes[1].triangles->lower()).x(), 0.1,
               1e-6);
   EXPECT_EQ(scene.colliders.meshes[1].voxel_size, 0.002);
+  // rviz knows neither the scene's folder nor the node's: the relative path is drawn by its absolute one.
+  EXPECT_EQ(scene.colliders.meshes[1].uri, std::string("file://") + SOURCE_DIR + "/config/meshes/part.stl");
   EXPECT_EQ(scene.colliders.meshes[1].at.friction, 0.4);
   const World world = buildWorld(scene);
   ASSERT_EQ(world.colliderPoses().size(), 3u);

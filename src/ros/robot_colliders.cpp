@@ -62,7 +62,9 @@ void addRobotColliders(const std::string& urdf_xml, const RobotCollidersDef& rob
             throw std::invalid_argument("scale " + std::to_string(mesh.scale.x()) + " " +
                                         std::to_string(mesh.scale.y()) + " " + std::to_string(mesh.scale.z()) +
                                         " is not > 0 in every axis");
-          mesh.triangles = std::make_shared<const TriangleMesh>(readTriangleMesh(resolveMeshUri(mesh.uri, ""), mesh.scale));
+          const std::string path = resolveMeshUri(mesh.uri, "");
+          mesh.triangles = std::make_shared<const TriangleMesh>(readTriangleMesh(path, mesh.scale));
+          mesh.uri = drawableMeshUri(mesh.uri, path);
         }
         catch (const std::invalid_argument& e)
         {

@@ -1,6 +1,7 @@
 #include "soft_body_sim/scene/mesh_uri.h"
 
 #include <cstdlib>
+#include <filesystem>
 #include <stdexcept>
 
 #include <ros/package.h>
@@ -38,6 +39,13 @@ std::string resolveMeshUri(const std::string& uri, const std::string& base_direc
   if (uri.empty() || uri.front() == '/' || base_directory.empty())
     return uri;
   return base_directory + "/" + uri;
+}
+
+std::string drawableMeshUri(const std::string& uri, const std::string& path)
+{
+  if (startsWith(uri, "package://") || startsWith(uri, "file://"))
+    return uri;
+  return "file://" + std::filesystem::absolute(path).lexically_normal().string();
 }
 
 }  // namespace soft_body_sim

@@ -214,6 +214,7 @@ Mesh readMesh(const Context& ctx, const Field& field)
   {
     ctx.fail(uri, e.what());
   }
+  mesh.uri = drawableMeshUri(mesh.uri, path);
   return mesh;
 }
 

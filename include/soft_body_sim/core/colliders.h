@@ -78,7 +78,7 @@ class MeshField;
 struct Mesh
 {
   ColliderPlacement at;
-  std::string uri;  ///< the file as the scene names it (`mesh`: package://, file:// or a path), for drawing
+  std::string uri;  ///< the file as rviz loads it: the scene's package:// or file://, a plain path as file:// and absolute
   Eigen::Vector3d scale = Eigen::Vector3d::Ones();  ///< per local axis [-], each > 0
   double voxel_size = 0.0;  ///< [m] edge of the distance field's voxels, > 0; 0 = defaultVoxelSize
   std::shared_ptr<const TriangleMesh> triangles;  ///< readTriangleMesh of the file, scale applied

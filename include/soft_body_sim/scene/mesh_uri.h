@@ -12,4 +12,9 @@ namespace soft_body_sim
 /// another scheme.
 std::string resolveMeshUri(const std::string& uri, const std::string& base_directory);
 
+/// The URI that rviz loads a mesh by (a MESH_RESOURCE marker): `uri` itself if it is package:// or
+/// file://, else file:// and the absolute form of `path` (what resolveMeshUri made of it), since rviz
+/// knows neither the scene file's folder nor the node's working directory.
+std::string drawableMeshUri(const std::string& uri, const std::string& path);
+
 }  // namespace soft_body_sim
