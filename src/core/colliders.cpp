@@ -81,7 +81,7 @@ void checkCollider(const Mesh& mesh)
                     "no triangles were read from '" + mesh.uri + "'");
   requireDefinition(mesh.voxel_size >= 0.0 && std::isfinite(mesh.voxel_size), what, { "voxel_size" },
                     "voxel_size must be > 0 (or 0: the default, the largest extent / 100)");
-  const double voxel = mesh.voxel_size > 0.0 ? mesh.voxel_size : defaultVoxelSize(*mesh.triangles);
+  const double voxel = fieldVoxelSize(mesh);
   const double voxels = fieldVoxels(*mesh.triangles, voxel, 0.0);
   requireDefinition(voxels <= kMaxFieldVoxels, what, { "voxel_size" },
                     "voxel_size " + std::to_string(voxel) + " m spans the mesh's bounding box with " +

@@ -20,6 +20,11 @@ struct MeshField::Grid
 
 double defaultVoxelSize(const TriangleMesh& mesh) { return (mesh.upper() - mesh.lower()).maxCoeff() / kDefaultVoxelsPerExtent; }
 
+double fieldVoxelSize(const Mesh& mesh)
+{
+  return mesh.voxel_size > 0.0 ? mesh.voxel_size : defaultVoxelSize(*mesh.triangles);
+}
+
 double fieldVoxels(const TriangleMesh& mesh, double voxel, double band)
 {
   const Eigen::Vector3d extent = mesh.upper() - mesh.lower() + Eigen::Vector3d::Constant(2.0 * band);
@@ -109,7 +114,7 @@ void buildMeshFields(std::vector<Mesh>& meshes, double contact_radius)
   for (Mesh& mesh : meshes)
   {
     checkCollider(mesh);
-    const double voxel = mesh.voxel_size > 0.0 ? mesh.voxel_size : defaultVoxelSize(*mesh.triangles);
+    const double voxel = fieldVoxelSize(mesh);
     // Three voxels at least (OpenVDB's usual narrow band), and the largest contact radius with two to spare:
     // a node's contact is then always within the band.
     const double band = std::max(3.0 * voxel, contact_radius + 2.0 * voxel);

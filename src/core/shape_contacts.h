@@ -1,5 +1,5 @@
-// Contact with rigid shapes (spheres, capsules, boxes, cylinders, meshes): one template over the shape, whose geometry is
-// surfaceDistance (colliders.h). Private to the core.
+// Contact with rigid shapes (spheres, capsules, boxes, cylinders, meshes): one template over the shape,
+// whose geometry is surfaceDistance (colliders.h). Private to the core.
 #pragma once
 
 #include <algorithm>

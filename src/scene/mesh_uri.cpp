@@ -10,15 +10,16 @@ namespace soft_body_sim
 {
 namespace
 {
+const std::string kPackageScheme = "package://", kFileScheme = "file://";
+
 bool startsWith(const std::string& text, const std::string& prefix) { return text.rfind(prefix, 0) == 0; }
 }  // namespace
 
 std::string resolveMeshUri(const std::string& uri, const std::string& base_directory)
 {
-  const std::string package_scheme = "package://", file_scheme = "file://";
-  if (startsWith(uri, package_scheme))
+  if (startsWith(uri, kPackageScheme))
   {
-    const std::string rest = uri.substr(package_scheme.size());
+    const std::string rest = uri.substr(kPackageScheme.size());
     const std::size_t slash = rest.find('/');
     const std::string package = rest.substr(0, slash);
     if (package.empty() || slash == std::string::npos || slash + 1 == rest.size())
@@ -32,8 +33,8 @@ std::string resolveMeshUri(const std::string& uri, const std::string& base_direc
     }
     return folder + rest.substr(slash);
   }
-  if (startsWith(uri, file_scheme))
-    return uri.substr(file_scheme.size());
+  if (startsWith(uri, kFileScheme))
+    return uri.substr(kFileScheme.size());
   if (uri.find("://") != std::string::npos)
     throw std::invalid_argument("'" + uri + "': only package://, file:// and plain paths are meshes");
   if (uri.empty() || uri.front() == '/' || base_directory.empty())
@@ -43,9 +44,9 @@ std::string resolveMeshUri(const std::string& uri, const std::string& base_direc
 
 std::string drawableMeshUri(const std::string& uri, const std::string& path)
 {
-  if (startsWith(uri, "package://") || startsWith(uri, "file://"))
+  if (startsWith(uri, kPackageScheme) || startsWith(uri, kFileScheme))
     return uri;
-  return "file://" + std::filesystem::absolute(path).lexically_normal().string();
+  return kFileScheme + std::filesystem::absolute(path).lexically_normal().string();
 }
 
 }  // namespace soft_body_sim

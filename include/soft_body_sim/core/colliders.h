@@ -97,8 +97,7 @@ struct Colliders
 };
 
 /// Every shape's placement, in the order of Colliders' vectors (spheres, capsules, boxes, cylinders,
-/// meshes): for the
-/// callers that treat all shapes alike (which follow a tf frame).
+/// meshes): for the callers that treat all shapes alike (which follow a tf frame).
 inline std::vector<const ColliderPlacement*> placements(const Colliders& colliders)
 {
   std::vector<const ColliderPlacement*> all;

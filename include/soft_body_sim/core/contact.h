@@ -34,7 +34,7 @@ struct ColliderPose
   /// [m] sphere: its diameter three times; capsule and cylinder: (2 radius, 2 radius, length); box: its size;
   /// mesh: its scale [-] (the file's coordinates are metres).
   Vec3 size = Vec3::Zero();
-  std::string mesh;  ///< a mesh's file as the scene names it (package://, file:// or a path); else empty
+  std::string mesh;  ///< a mesh's file as rviz loads it (Mesh::uri: package:// or file://); else empty
 
   static ColliderPose of(const Sphere& s) { return { s.at.name, Shape::Sphere, s.at.position, s.at.orientation, Vec3::Constant(2.0 * s.radius), {} }; }
   static ColliderPose of(const Capsule& c)

@@ -37,6 +37,8 @@ TriangleMesh readTriangleMesh(const std::string& path, const Eigen::Vector3d& sc
 /// mesh collider that sets none.
 constexpr double kDefaultVoxelsPerExtent = 100.0;
 double defaultVoxelSize(const TriangleMesh& mesh);
+/// The voxel size [m] of `mesh`'s field: its voxel_size, or defaultVoxelSize of its triangles for 0.
+double fieldVoxelSize(const Mesh& mesh);
 
 /// The most voxels a mesh's field may span over its bounding box (2^24: 64 MB of float distances if
 /// the mesh filled it): a finer voxel_size is refused.

@@ -73,8 +73,8 @@ public:
   /// True if body `body` (index into model().bodies) takes a target.
   bool takesTarget(std::size_t body) const;
 
-  /// The current pose of every placed drawable collider, by kind (spheres, capsules, boxes, cylinders),
-  /// each kind in declaration order.
+  /// The current pose of every placed drawable collider, by kind (spheres, capsules, boxes, cylinders,
+  /// meshes), each kind in declaration order.
   std::vector<ColliderPose> colliderPoses() const { return contacts_.poses(); }
   /// Moves collider `name` to `pose` during the next step at constant linear and angular velocity (which
   /// friction sees), as moveAnchor; false if there is none of that name. The latest call before a step wins.
