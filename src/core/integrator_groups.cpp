@@ -32,12 +32,13 @@ void IntegratorGroups::prepare(const Model& model)
     rebuild(model);
 }
 
-void IntegratorGroups::step(const Model& model, State& state, double h, int iterations)
+void IntegratorGroups::step(const Model& model, State& state, double h, int iterations,
+                            const ContactQuery* contacts)
 {
   if (groups_.empty())
-    integrator_->step(model, state, h, iterations);
+    integrator_->stepWithContacts(model, state, h, iterations, contacts);
   for (Group& group : groups_)
-    group.integrator->step(group.model, state, h, iterations);
+    group.integrator->stepWithContacts(group.model, state, h, iterations, contacts);
 }
 
 void IntegratorGroups::invalidate()

@@ -73,7 +73,7 @@ void World::moveAnchors(double h)
 void World::integrate(double h)
 {
   contacts_.remember(state_);
-  integrators_.step(model_, state_, h, settings_.iterations);
+  integrators_.step(model_, state_, h, settings_.iterations, contacts_.query());
   if (integration_observer_)
     integration_observer_(model_, state_);
 }

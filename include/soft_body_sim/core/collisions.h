@@ -34,6 +34,21 @@ public:
     return collideWithPlanes(planes_, model, start, state, 2.0 * model.gravity.norm() * h, touching_, h);
   }
 
+  bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const override
+  {
+    bool found = false;
+    for (const Plane& plane : planes_)
+    {
+      const double depth = model.contact_radius[node] - (x - plane.point).dot(plane.normal);
+      if (depth > -margin && (!found || depth > contact.depth))
+      {
+        contact = NodeContact{ plane.normal, Vec3::Zero(), plane.friction, depth };
+        found = true;
+      }
+    }
+    return found;
+  }
+
 private:
   std::vector<Plane> planes_;
   std::vector<std::uint8_t> touching_;  ///< per node: on a plane after the last sub-step

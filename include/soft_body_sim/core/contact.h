@@ -1,6 +1,7 @@
 // The contact stage of a step: after each sub-step's integration, every kind of collider the scene
 // declares (colliders.h) pushes the free nodes, with their contact radius, out of its shapes and changes
-// their velocities (bounce, friction relative to the shape's own motion). A new kind is its shape struct
+// their velocities (bounce, friction relative to the shape's own motion). Solves that take contact into
+// themselves (xpbd's chains) ask it where a node touches through ContactQuery. A new kind is its shape struct
 // in colliders.h, its ColliderKind in its own file (or a surfaceDistance for ShapeContacts), one line in
 // makeColliderKinds (contact.cpp) and its reader: nothing in World. A scene that declares no colliders
 // has no kinds here and pays nothing.
@@ -12,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "soft_body_sim/core/integrator.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
@@ -68,6 +70,12 @@ public:
   /// by h and resolves the contacts of every free node with them. True if it touched any node (the
   /// integrators' caches of the state are then stale).
   virtual bool resolve(const Model& model, const NodeArray& start, State& state, double h) = 0;
+  /// ContactQuery::touching over its shapes (as they are before this sub-step's resolve moves them).
+  virtual bool touching(const Model& /*model*/, int /*node*/, const Vec3& /*x*/, double /*margin*/,
+                        NodeContact& /*contact*/) const
+  {
+    return false;
+  }
   /// Appends the current pose of each of its drawable shapes (planes are infinite: none).
   virtual void appendPoses(std::vector<ColliderPose>& /*poses*/) const {}
   /// Moves its shape `name` to `goal` over the next dt [s] at constant linear and angular velocity (its
@@ -84,10 +92,26 @@ public:
 /// on a collider that its kind rejects.
 std::vector<std::unique_ptr<ColliderKind>> makeColliderKinds(const Model& model);
 
-class ContactStage
+class ContactStage final : public ContactQuery
 {
 public:
   explicit ContactStage(const Model& model) : kinds_(makeColliderKinds(model)) {}
+
+  /// What the integrators' solves may ask (null without colliders: they pay nothing).
+  const ContactQuery* query() const { return kinds_.empty() ? nullptr : this; }
+
+  bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const override
+  {
+    bool found = false;
+    NodeContact candidate;
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      if (kind->touching(model, node, x, margin, candidate) && (!found || candidate.depth > contact.depth))
+      {
+        contact = candidate;
+        found = true;
+      }
+    return found;
+  }
 
   /// Before a sub-step's integration: keeps where the nodes start (friction acts on the sub-step's
   /// displacement). Nothing without colliders.

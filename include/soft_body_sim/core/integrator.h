@@ -28,6 +28,25 @@ bool integratorFromName(const std::string& name, IntegratorType& type);
 /// Every valid name, in declaration order.
 const std::vector<std::string>& integratorNames();
 
+/// A node within its contact radius of a collider's surface, as a solve sees it (ContactQuery).
+struct NodeContact
+{
+  Vec3 normal;            ///< the surface's outward unit normal
+  Vec3 velocity;          ///< [m/s] of the surface point (0 for a fixed collider)
+  double friction = 0.0;  ///< Coulomb coefficient [-]
+  double depth = 0.0;     ///< [m] how far the node is inside its contact radius (< 0: that far outside it)
+};
+
+/// The colliders as a solve can ask about them (the contact stage, contact.h).
+class ContactQuery
+{
+public:
+  virtual ~ContactQuery() = default;
+  /// The surface nearest to node `node` placed at `x` [m], if it is within the node's contact radius
+  /// plus `margin` [m] of one; the deepest if several are.
+  virtual bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const = 0;
+};
+
 class Integrator
 {
 public:
@@ -35,6 +54,13 @@ public:
   /// Advances `state` by h [s]. Pinned nodes (inverse mass 0) are never moved: their position and
   /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
   virtual void step(const Model& model, State& state, double h, int iterations) = 0;
+  /// step(), where the scene has colliders (`contacts`; null: none). A solve that can take contacts into
+  /// it does (xpbd's chains: chain_contacts.h); the others leave them to the contact stage that follows.
+  virtual void stepWithContacts(const Model& model, State& state, double h, int iterations,
+                                const ContactQuery* /*contacts*/)
+  {
+    step(model, state, h, iterations);
+  }
   /// The state was changed from outside the integrator (an anchor or controller moved its nodes, a
   /// plane contact changed a velocity, a node was set): drop anything cached from the old state.
   virtual void invalidate() {}

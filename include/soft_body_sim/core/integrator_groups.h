@@ -30,8 +30,9 @@ public:
 
   /// Makes the groups again if a switch or a model change asked for it (the first stage of a step).
   void prepare(const Model& model);
-  /// Advances every free node of `state` by one sub-step h [s].
-  void step(const Model& model, State& state, double h, int iterations);
+  /// Advances every free node of `state` by one sub-step h [s], among the colliders `contacts` (null:
+  /// none).
+  void step(const Model& model, State& state, double h, int iterations, const ContactQuery* contacts);
 
   /// The state was changed from outside the integrators: they drop what they cached from it.
   void invalidate();

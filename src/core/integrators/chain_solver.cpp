@@ -167,13 +167,15 @@ void ChainSolver::reserve(std::size_t rows)
   mobility_b_.resize(rows);
   diagonal_.resize(rows);
   coupling_.resize(rows);
+  coupling_below_.resize(rows);
   rhs_.resize(rows);
   upper_.resize(rows);
   delta_.resize(rows);
 }
 
 void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
-                        const NodeArray& x_prev, double h, const double* tension, NodeArray& x, double* lambda)
+                        const NodeArray& x_prev, double h, const double* tension, const NodeHolds* holds,
+                        bool push, NodeArray& x, double* lambda)
 {
   for (std::size_t i = 0; i < count; ++i)
   {
@@ -182,7 +184,7 @@ void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::Ve
     start_lambda_[i] = lambda[i];
     estimate_[i] = tension[i];
   }
-  newtonStep(rows, count, inverse_mass, x_prev, h, x, lambda);
+  newtonStep(rows, count, inverse_mass, x_prev, h, holds, push, x, lambda);
   // This sub-step's tension -lambda / h^2 against the estimate its geometric stiffness used.
   const double inverse_h2 = 1.0 / (h * h);
   bool underestimated = false;
@@ -195,7 +197,7 @@ void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::Ve
   if (underestimated)
   {
     restart(rows, count, x, lambda);
-    newtonStep(rows, count, inverse_mass, x_prev, h, x, lambda);
+    newtonStep(rows, count, inverse_mass, x_prev, h, holds, push, x, lambda);
   }
 }
 
@@ -210,7 +212,8 @@ void ChainSolver::restart(const SweepRow* rows, std::size_t count, NodeArray& x,
 }
 
 void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
-                             const NodeArray& x_prev, double h, NodeArray& x, double* lambda)
+                             const NodeArray& x_prev, double h, const NodeHolds* holds, bool push, NodeArray& x,
+                             double* lambda)
 {
   // Each row at the current positions (as projectDistance, but every row at the same x): its direction,
   // its right-hand side -C - alpha~ lambda - gamma u . ((x_a - x_prev_a) - (x_b - x_prev_b)), and its
@@ -244,11 +247,21 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     const auto before = [&]() -> const Matrix3& {
       return rows[i - 1].a == shared_before ? mobility_a_[i - 1] : mobility_b_[i - 1];
     };
-    mobility_a_[i] = row.a == shared_before ? before() : mobility(rows, count, i, row.a, inverse_mass);
-    mobility_b_[i] = row.b == shared_before ? before() : mobility(rows, count, i, row.b, inverse_mass);
+    mobility_a_[i] = row.a == shared_before ? before() : mobility(rows, count, i, row.a, inverse_mass, holds);
+    mobility_b_[i] = row.b == shared_before ? before() : mobility(rows, count, i, row.b, inverse_mass, holds);
     if (i + 1 < count)
       shared_before = row.a == rows[i + 1].a || row.a == rows[i + 1].b ? row.a : row.b;
   }
+  // Kinetic friction's displacement W~ h^2 f at each row's nodes enters its constraint's linearisation.
+  const bool pushing = push && holds != nullptr;
+  const auto pushed = [&](int node, const Matrix3& mobility) -> Vec3 {
+    return holds->kind[static_cast<std::size_t>(node)] == NodeHolds::kSlide ? Vec3(mobility * holds->push.col(node))
+                                                                             : Vec3::Zero();
+  };
+  if (pushing)
+    for (std::size_t i = 0; i < count; ++i)
+      rhs_[i] -= direction_.col(static_cast<Eigen::Index>(i))
+                     .dot(pushed(rows[i].a, mobility_a_[i]) - pushed(rows[i].b, mobility_b_[i]));
   // The system with row i divided by 1 + gamma_i, symmetric positive definite and tridiagonal:
   //   diagonal_i = u_i . (W~_a + W~_b) u_i + alpha~_i / (1 + gamma_i),
   //   coupling_i = (+-u_i) . W~_s (+-u_{i+1}) for the node s rows i and i + 1 share, the signs those of
@@ -266,7 +279,9 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     const bool at_a = row.a == next.a || row.a == next.b;
     const double sign = (at_a ? 1.0 : -1.0) * ((at_a ? row.a : row.b) == next.a ? 1.0 : -1.0);
     const Matrix3& shared = at_a ? mobility_a_[i] : mobility_b_[i];
-    coupling_[i] = sign * u.dot(shared * direction_.col(static_cast<Eigen::Index>(i + 1)));
+    const Vec3 v = direction_.col(static_cast<Eigen::Index>(i + 1));
+    coupling_[i] = sign * u.dot(shared * v);
+    coupling_below_[i] = sign * v.dot(shared * u);
   }
   // Thomas algorithm (LDL^T of a tridiagonal matrix): for a symmetric positive definite matrix it is
   // stable without pivoting and every pivot is positive. With a free end the rows are independent, so a
@@ -276,7 +291,7 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
   constexpr double kPivotFloor = 64.0 * std::numeric_limits<double>::epsilon();
   for (std::size_t i = 0; i < count; ++i)
   {
-    const double lower = i > 0 ? coupling_[i - 1] : 0.0;
+    const double lower = i > 0 ? coupling_below_[i - 1] : 0.0;
     const double pivot = i > 0 ? diagonal_[i] - lower * upper_[i - 1] : diagonal_[i];
     if (!(pivot > kPivotFloor * diagonal_[i]))
     {
@@ -299,13 +314,25 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     x.col(row.a) += mobility_a_[i] * (delta_[i] * u);
     x.col(row.b) -= mobility_b_[i] * (delta_[i] * u);
   }
+  // ... and the friction's displacement, once per node (a node shared with the row before has had it).
+  if (pushing)
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      const SweepRow& row = rows[i];
+      const auto first_time = [&](int node) { return i == 0 || (rows[i - 1].a != node && rows[i - 1].b != node); };
+      if (first_time(row.a))
+        x.col(row.a) += pushed(row.a, mobility_a_[i]);
+      if (first_time(row.b))
+        x.col(row.b) += pushed(row.b, mobility_b_[i]);
+    }
 }
 
 ChainSolver::Matrix3 ChainSolver::mobility(const SweepRow* rows, std::size_t count, std::size_t i, int node,
-                                           const Eigen::VectorXd& inverse_mass) const
+                                           const Eigen::VectorXd& inverse_mass, const NodeHolds* holds) const
 {
   const double w = inverse_mass[node];
-  if (w == 0.0)
+  const std::uint8_t hold = holds ? holds->kind[static_cast<std::size_t>(node)] : std::uint8_t{ NodeHolds::kFree };
+  if (w == 0.0 || hold == NodeHolds::kStick)
     return Matrix3::Zero();
   Matrix3 inertia = (1.0 / w) * Matrix3::Identity();
   bool stiffened = false;
@@ -318,7 +345,15 @@ ChainSolver::Matrix3 ChainSolver::mobility(const SweepRow* rows, std::size_t cou
     stiffened = true;
   }
   // Without tension M~ = m I: w I exactly, as the Gauss-Seidel update uses.
-  return stiffened ? Matrix3(inertia.inverse()) : Matrix3(w * Matrix3::Identity());
+  const Matrix3 free = stiffened ? Matrix3(inertia.inverse()) : Matrix3(w * Matrix3::Identity());
+  if (hold == NodeHolds::kFree)
+    return free;
+  const Vec3 n = holds->normal.col(node);
+  const Matrix3 tangent = Matrix3::Identity() - n * n.transpose();
+  // Kinetic friction mu nu against the slip s, nu = -n . g the normal impulse that the rows' impulse g
+  // presses the node on with: the node moves by P W~ P (g + mu (n . g) s).
+  const Vec3 slip = holds->friction[static_cast<std::size_t>(node)] * holds->slip.col(node);
+  return tangent * free * tangent * (Matrix3::Identity() + slip * n.transpose());
 }
 
 }  // namespace soft_body_sim

@@ -36,6 +36,25 @@ struct RowPartition
 /// nodes are free: recompute it when a node is pinned or released.
 RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const Eigen::VectorXd& inverse_mass);
 
+/// How contacts hold the nodes of the chains in their solve (chain_contacts.h), per node of the model.
+struct NodeHolds
+{
+  enum Kind : std::uint8_t
+  {
+    kFree,   ///< not held
+    kSlide,  ///< held on a surface: it moves only in the surface's tangent plane
+    kStick,  ///< held in place (moving with the surface)
+  };
+  std::vector<std::uint8_t> kind;
+  NodeArray normal;    ///< the surface's unit normal at a kSlide node
+  NodeArray slip;      ///< the unit direction a kSlide node slips in, in its tangent plane
+  std::vector<double> friction;  ///< the kinetic friction coefficient at a kSlide node
+  /// h^2 f [kg m] of the part of a kSlide node's kinetic friction f that does not come from the rows (the
+  /// friction of its own inertia and weight pressing it on), taken into the first Newton step of its
+  /// sub-step: x += W~ h^2 f with the rows' dlambda that answer it in the same linear solve.
+  NodeArray push;
+};
+
 /// One Newton step of XPBD on a chain, with the chain's geometric stiffness.
 ///
 /// Linearised at the predicted positions, the system above treats the turning of the rows explicitly:
@@ -70,24 +89,26 @@ public:
   /// with this one's if that was too small, see above): builds the tridiagonal system at the current
   /// positions, solves it, and applies
   ///   lambda_i += dlambda_i,  x_a += W~_a u_i dlambda_i,  x_b -= W~_b u_i dlambda_i
-  /// to every row at once. A row that cannot move (both ends pinned, or coincident ends) keeps
-  /// dlambda = 0 and decouples from its neighbours.
+  /// to every row at once. A row that cannot move (both ends pinned or stuck, or coincident ends) keeps
+  /// dlambda = 0 and decouples from its neighbours. `holds` (null: none) restrict the nodes held by
+  /// contacts: W~ of a stuck node is 0, of a sliding one P W~ P with P = I - n n^T; with `push`, their
+  /// kinetic friction acts in this step.
   void solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-             double h, const double* tension, NodeArray& x, double* lambda);
+             double h, const double* tension, const NodeHolds* holds, bool push, NodeArray& x, double* lambda);
 
 private:
   using Matrix3 = Eigen::Matrix3d;
 
   /// The step itself, with the geometric stiffness of the tensions in estimate_.
   void newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-                  double h, NodeArray& x, double* lambda);
+                  double h, const NodeHolds* holds, bool push, NodeArray& x, double* lambda);
 
   /// Puts the chain's nodes and lambdas back where solve() found them.
   void restart(const SweepRow* rows, std::size_t count, NodeArray& x, double* lambda) const;
 
   /// W~ at `node`, one of the nodes of row i.
   Matrix3 mobility(const SweepRow* rows, std::size_t count, std::size_t i, int node,
-                   const Eigen::VectorXd& inverse_mass) const;
+                   const Eigen::VectorXd& inverse_mass, const NodeHolds* holds) const;
 
   NodeArray start_a_;             ///< each row's node a before the step, for a repeat [m]
   NodeArray start_b_;             ///< ... and its node b
@@ -98,7 +119,8 @@ private:
   std::vector<Matrix3> mobility_a_;  ///< W~ at each row's node a [1/kg]
   std::vector<Matrix3> mobility_b_;  ///< ... and at its node b
   std::vector<double> diagonal_;
-  std::vector<double> coupling_;  ///< (J W~ J^T)_{i,i+1} = (J W~ J^T)_{i+1,i}
+  std::vector<double> coupling_;        ///< (J W~ J^T)_{i,i+1}
+  std::vector<double> coupling_below_;  ///< (J W~ J^T)_{i+1,i}: the same unless kinetic friction acts there
   std::vector<double> rhs_;
   std::vector<double> upper_;     ///< the Thomas algorithm's modified super-diagonal c'_i
   std::vector<double> delta_;     ///< its modified right-hand side d'_i, then dlambda_i

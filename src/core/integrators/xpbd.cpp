@@ -3,6 +3,7 @@
 #include <utility>
 #include <vector>
 
+#include "chain_contacts.h"
 #include "chain_solver.h"
 #include "integrator_kit.h"
 #include "soft_body_sim/core/forces.h"
@@ -56,8 +57,14 @@ class Xpbd final : public Integrator
 public:
   void step(const Model& model, State& state, double h, int iterations) override
   {
+    stepWithContacts(model, state, h, iterations, nullptr);
+  }
+
+  void stepWithContacts(const Model& model, State& state, double h, int iterations,
+                        const ContactQuery* contacts) override
+  {
     preSolve(model, state, h);
-    solve(model, state.position, h, iterations);
+    solve(model, state.position, h, iterations, contacts);
     postSolve(model, state, h);
   }
 
@@ -80,7 +87,7 @@ private:
     }
   }
 
-  void solve(const Model& model, NodeArray& x, double h, int iterations)
+  void solve(const Model& model, NodeArray& x, double h, int iterations, const ContactQuery* contacts)
   {
     const std::size_t row_count = model.springs.size() + model.constraints.size();
     // The partition into chains depends on which nodes are pinned (modelChanged() follows World::attach
@@ -94,20 +101,26 @@ private:
     rows_.resize(row_count);  // sized once: no allocation after the first sub-step
     lambda_.setZero(static_cast<Eigen::Index>(row_count));
     cell_lambda_.setZero(static_cast<Eigen::Index>(model.cells.size()));
+    // Rows are stale after a new h or a new order (modelChanged()): the chains' rows are written here, the
+    // swept ones by the first sweep as it goes.
+    const bool stale = h != rows_h_;
+    const double inverse_h2 = 1.0 / (h * h);
+    if (stale)
+      for (std::size_t k = swept_count_; k < row_count; ++k)
+        rows_[k] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
+    const bool held =
+        contacts != nullptr && chain_starts_.size() > 1 && chain_contacts_.hold(model, *contacts, previous_, h, x);
+    if (held)
+      startChains(model, h, true);
     for (int iteration = 0; iteration < iterations; ++iteration)
     {
-      if (iteration == 0 && h != rows_h_)
+      if (iteration == 0 && stale)
       {
-        // Rows are stale (new h, or ordered again after modelChanged()): the first sweep
-        // writes them as it goes, then the chains' rows are written.
-        const double inverse_h2 = 1.0 / (h * h);
         for (std::size_t k = 0; k < swept_count_; ++k)
         {
           rows_[k] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
           projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
         }
-        for (std::size_t k = swept_count_; k < row_count; ++k)
-          rows_[k] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
         rows_h_ = h;
       }
       else
@@ -117,17 +130,51 @@ private:
       }
       // Chains share no free node with the swept rows: each is one block of a block Gauss-Seidel, solved
       // exactly (one Newton step per iteration).
-      for (std::size_t c = 0; c + 1 < chain_starts_.size(); ++c)
-        chains_.solve(&rows_[chain_starts_[c]], chain_starts_[c + 1] - chain_starts_[c], model.inverse_mass, previous_,
-                      h, chain_tension_.data() + chain_starts_[c], x, lambda_.data() + chain_starts_[c]);
+      solveChains(model, h, held, iteration, x);
       for (std::size_t k = 0; k < model.cells.size(); ++k)
         solveCell(model.cells[k], model.inverse_mass, h, x, cell_lambda_[static_cast<Eigen::Index>(k)]);
     }
+    // Contacts that the solve's forces break change their holds, and the chains are solved again from
+    // their prediction (chain_contacts.h); the swept rows and cells share no free node with them.
+    for (int pass = 1;
+         held && chain_contacts_.check(model, rows_, swept_count_, lambda_.data(), previous_, h, x) &&
+         pass < ChainContacts::kPasses;
+         ++pass)
+    {
+      chain_contacts_.place(model, previous_, h, x);
+      startChains(model, h, false);
+      for (int iteration = 0; iteration < iterations; ++iteration)
+        solveChains(model, h, held, iteration, x);
+    }
     // The chains' tensions T = -lambda / h^2 [N] (lambda < 0 pulls the ends together), for the next
     // sub-step's geometric stiffness; compression adds none.
-    const double inverse_h2 = 1.0 / (h * h);
     for (std::size_t k = swept_count_; k < row_count; ++k)
       chain_tension_[static_cast<Eigen::Index>(k)] = std::max(0.0, -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2);
+  }
+
+  /// Every chain, one Newton step each (chain_solver.h), with the contacts' holds if `held` (their
+  /// kinetic friction in the first iteration).
+  void solveChains(const Model& model, double h, bool held, int iteration, NodeArray& x)
+  {
+    const NodeHolds* holds = held ? &chain_contacts_.holds() : nullptr;
+    for (std::size_t c = 0; c + 1 < chain_starts_.size(); ++c)
+      chains_.solve(&rows_[chain_starts_[c]], chain_starts_[c + 1] - chain_starts_[c], model.inverse_mass, previous_,
+                    h, chain_tension_.data() + chain_starts_[c], holds, iteration == 0, x,
+                    lambda_.data() + chain_starts_[c]);
+  }
+
+  /// The chains' multipliers at the start of a solve with contacts: a row between two nodes that cannot
+  /// move (pinned or stuck) keeps its tension (see ChainContacts): the last sub-step's in the first pass,
+  /// the last pass's in the others; the other rows start at 0.
+  void startChains(const Model& model, double h, bool first_pass)
+  {
+    for (std::size_t k = swept_count_; k < order_.size(); ++k)
+    {
+      const SweepRow& row = rows_[k];
+      const Eigen::Index r = static_cast<Eigen::Index>(k);
+      const bool frozen = chain_contacts_.immobile(model, row.a) && chain_contacts_.immobile(model, row.b);
+      lambda_[r] = !frozen ? 0.0 : first_pass ? -chain_tension_[r] * h * h : lambda_[r];
+    }
   }
 
   /// Row r of the solve: spring r (compliance 1 / k, damping c) for r < springs.size(), else a distance
@@ -170,6 +217,27 @@ private:
     }
     chains_.reserve(longest);
     chain_tension_.setZero(static_cast<Eigen::Index>(order_.size()));
+    // Each chain's nodes in path order, and its rows between them, for the contacts in its solve.
+    std::vector<ChainPath> paths;
+    for (std::size_t c = 0; c + 1 < chain_starts_.size(); ++c)
+    {
+      ChainPath path;
+      for (std::size_t k = chain_starts_[c]; k < chain_starts_[c + 1]; ++k)
+      {
+        const auto [a, b] = ends[order_[k]];
+        if (path.nodes.empty())
+        {
+          // The first row's end that the second row does not share.
+          const bool a_leads = k + 1 == chain_starts_[c + 1] ||
+                               (ends[order_[k + 1]].first != a && ends[order_[k + 1]].second != a);
+          path.nodes.push_back(a_leads ? a : b);
+        }
+        path.nodes.push_back(path.nodes.back() == a ? b : a);
+        path.rows.push_back(k);
+      }
+      paths.push_back(std::move(path));
+    }
+    chain_contacts_.setPaths(model, std::move(paths));
     ordered_nodes_ = model.nodeCount();
   }
 
@@ -221,6 +289,7 @@ private:
   std::vector<std::size_t> chain_starts_;  ///< chain c is order_[chain_starts_[c], chain_starts_[c + 1])
   int ordered_nodes_ = -1;
   ChainSolver chains_;
+  ChainContacts chain_contacts_;
   Eigen::VectorXd chain_tension_;     ///< [N] per row in solve order: the chains' tensions at the last sub-step
   std::vector<SweepRow> rows_;        ///< the rows in solve order, valid for h = rows_h_
   double rows_h_ = 0.0;               ///< [s]; 0 = rows not built
