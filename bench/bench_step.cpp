@@ -10,6 +10,8 @@
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
 // capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
+// BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
+// touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
 #include <cmath>
 
 #include <benchmark/benchmark.h>
@@ -203,6 +205,73 @@ void BM_RopeOnColliders(benchmark::State& bench, Shape shape)
                           world.settings().substeps);
 }
 
+/// A rope of 401 nodes (5 mm links, 20 g/m) with loads of 0.5 and 1 kg at its ends, laid over a capsule
+/// of radius 0.1 m and friction 0.3 (its half circle over the top, its ends hanging 0.835 m straight
+/// down; the capstan ratio 2.6 > 2: it holds) or, with `over_capsule` false, the same shape with no
+/// capsule and its nodes over the top pinned, where the stuck rope would be: xpbd solves the hanging
+/// parts as chains (chain_solver.h) either way, and the difference is the price of the contacts inside
+/// their solve (chain_contacts.h).
+SceneDef loadedRope(bool over_capsule)
+{
+  const double radius = 0.105, link = 0.005;  // radius: the capsule's and the rope's together
+  const int arc_links = static_cast<int>(std::round(M_PI * radius / link));
+  const int hanging_links = static_cast<int>(std::round(0.835 / link));
+  BodyDef rope;
+  rope.name = "rope";
+  rope.contact_radius = 0.005;
+  const auto add = [&rope, link](const Vec3& x) { rope.nodes.push_back(NodeDef{ x, 0.02 * link, Vec3::Zero(), false }); };
+  for (int k = hanging_links; k > 0; --k)
+    add(Vec3(-radius, 0, -k * link));
+  for (int k = 0; k <= arc_links; ++k)
+  {
+    const double angle = M_PI * (1.0 - static_cast<double>(k) / arc_links);
+    add(radius * Vec3(std::cos(angle), 0, std::sin(angle)));
+  }
+  for (int k = 1; k <= hanging_links; ++k)
+    add(Vec3(radius, 0, -k * link));
+  rope.nodes.front().mass += 0.5;
+  rope.nodes.back().mass += 1.0;
+  if (!over_capsule)
+    for (int k = 0; k <= arc_links; ++k)
+      rope.nodes[static_cast<std::size_t>(hanging_links + k)].pinned = true;
+  for (int i = 0; i + 1 < static_cast<int>(rope.nodes.size()); ++i)
+  {
+    rope.springs.push_back(SpringDef{ i, i + 1, 1e5, 0.0, std::nullopt });
+    rope.contact_segments.emplace_back(i, i + 1);
+  }
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 1 };
+  scene.bodies.push_back(rope);
+  if (over_capsule)
+  {
+    ColliderPlacement at;
+    at.name = "pulley";
+    at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * M_PI, Vec3::UnitX()));  // across the rope
+    at.friction = 0.3;
+    scene.colliders.capsules.push_back(Capsule{ at, 0.1, 0.3 });
+  }
+  return scene;
+}
+
+void BM_LoadedRope(benchmark::State& bench, bool over_capsule)
+{
+  World world = buildWorld(loadedRope(over_capsule));
+  for (int n = 0; n < 60; ++n)  // one second: the rope takes up its loads
+    world.step();
+  if (!world.takeDivergenceEvents().empty())
+  {
+    bench.SkipWithError("the loaded rope diverged");
+    return;
+  }
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
+}
+
 /// Node counts from 100 to 100,000, two per decade.
 void clothSizes(benchmark::internal::Benchmark* bench)
 {
@@ -227,6 +296,8 @@ BENCHMARK_CAPTURE(BM_RopeOnColliders, sphere, Shape::Sphere)->Args({ 1000, 0 })-
 BENCHMARK_CAPTURE(BM_RopeOnColliders, capsule, Shape::Capsule)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, box, Shape::Box)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, mesh_10k_triangles, Shape::Mesh)->Args({ 1000, 10 });
+BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
+BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
 
 }  // namespace
 }  // namespace soft_body_sim

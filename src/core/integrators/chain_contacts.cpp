@@ -99,7 +99,10 @@ bool ChainContacts::hold(const Model& model, const ContactQuery& contacts, const
     before_[k] = holds_.kind[k];
     predicted_.col(i) = x.col(i);
     NodeContact& contact = contact_[k];
-    if (!contacts.touching(model, i, x.col(i), holdMargin(model, i), contact))
+    // A new contact needs the prediction inside the contact radius; a held node stays held within the
+    // margin (a node just pulled off a surface is not caught again by it).
+    const double margin = before_[k] == NodeHolds::kFree ? 0.0 : holdMargin(model, i);
+    if (!contacts.touching(model, i, x.col(i), margin, contact))
     {
       holds_.kind[k] = NodeHolds::kFree;
       continue;
