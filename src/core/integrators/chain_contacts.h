@@ -26,16 +26,19 @@ struct ChainPath
 /// the next solve, which carries the load, moves it on. Measured on a 42 g rope with 0.5 kg loads over
 /// a capsule with friction 0.3: the loads ran as if the capsule were frictionless.
 ///
-/// How: each sub-step, every free node of a chain within its contact radius (and a margin) of a surface
-/// at its predicted position is held (NodeHolds). Consecutive held nodes of a chain form a run, which
-/// sticks or slides as a whole: an inextensible rope on a convex surface cannot slip at one node and not
-/// at the next.
+/// How: each sub-step, every free node of a chain whose predicted position is within its contact radius
+/// of a surface (or, if it was held at the last sub-step, within a margin beyond it) is held
+/// (NodeHolds). Consecutive held nodes of a chain form a run, which sticks or slides as a whole: an
+/// inextensible rope on a convex surface cannot slip at one node and not at the next.
 ///  - A stuck run moves with the surface, and the solve treats its nodes as pinned. The tensions inside
 ///    it are statically indeterminate: they are taken to change geometrically from one end's to the
 ///    other's, the distribution that asks the same friction of every node of a uniformly curved wrap.
 ///  - A sliding run is put on the surface and moves only in its tangent planes, against kinetic
-///    friction mu N opposite to its slip (N from the last solve), an external force in the chains' first
-///    Newton step (NodeHolds::push).
+///    friction mu N opposite to its slip, with N the normal force of this very solve: the part the rows
+///    press it on with is in the chain's linear system (ChainSolver::mobility), the rest (its own weight
+///    and inertia) an external force in the chains' first Newton step (NodeHolds::push). (N from the last
+///    solve instead feeds back: friction raises the tension on the tight side, which raises N, with a
+///    gain near mu theta; measured, the loads stopped above the capstan bound.)
 /// After a solve, the contact force on a held node is what keeps it where it is:
 ///    F = (m (x - x~) - J^T lambda) / h^2   (J^T lambda: the rows' impulses on it, times h),
 /// whose normal part N must push (else the node is let go) and whose tangential part must lie within the

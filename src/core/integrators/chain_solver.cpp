@@ -252,7 +252,8 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     if (i + 1 < count)
       shared_before = row.a == rows[i + 1].a || row.a == rows[i + 1].b ? row.a : row.b;
   }
-  // Kinetic friction's displacement W~ h^2 f at each row's nodes enters its constraint's linearisation.
+  // The displacement W~ h^2 f of the kinetic friction that the rows do not cause (NodeHolds::push) enters
+  // each row's linearisation.
   const bool pushing = push && holds != nullptr;
   const auto pushed = [&](int node, const Matrix3& mobility) -> Vec3 {
     return holds->kind[static_cast<std::size_t>(node)] == NodeHolds::kSlide ? Vec3(mobility * holds->push.col(node))
@@ -262,7 +263,8 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     for (std::size_t i = 0; i < count; ++i)
       rhs_[i] -= direction_.col(static_cast<Eigen::Index>(i))
                      .dot(pushed(rows[i].a, mobility_a_[i]) - pushed(rows[i].b, mobility_b_[i]));
-  // The system with row i divided by 1 + gamma_i, symmetric positive definite and tridiagonal:
+  // The system with row i divided by 1 + gamma_i, tridiagonal, and symmetric positive definite but where
+  // kinetic friction makes a sliding node's W~ unsymmetric (mobility()):
   //   diagonal_i = u_i . (W~_a + W~_b) u_i + alpha~_i / (1 + gamma_i),
   //   coupling_i = (+-u_i) . W~_s (+-u_{i+1}) for the node s rows i and i + 1 share, the signs those of
   //   gradC at s (+u at a row's node a, -u at its node b); zero next to a row that cannot move.
@@ -283,8 +285,9 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     coupling_[i] = sign * u.dot(shared * v);
     coupling_below_[i] = sign * v.dot(shared * u);
   }
-  // Thomas algorithm (LDL^T of a tridiagonal matrix): for a symmetric positive definite matrix it is
-  // stable without pivoting and every pivot is positive. With a free end the rows are independent, so a
+  // Thomas algorithm (LDL^T of a tridiagonal matrix, LU where it is unsymmetric): for a symmetric positive
+  // definite matrix it is stable without pivoting and every pivot is positive; friction's unsymmetric part
+  // is at most mu times a sliding node's normal coupling. With a free end the rows are independent, so a
   // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); one within the
   // round-off of the subtraction that made it is treated as zero: its row keeps dlambda = 0 and the
   // others are solved without it, rather than divided by noise.
@@ -314,7 +317,7 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     x.col(row.a) += mobility_a_[i] * (delta_[i] * u);
     x.col(row.b) -= mobility_b_[i] * (delta_[i] * u);
   }
-  // ... and the friction's displacement, once per node (a node shared with the row before has had it).
+  // ... and that displacement, once per node (a node shared with the row before has had it).
   if (pushing)
     for (std::size_t i = 0; i < count; ++i)
     {
