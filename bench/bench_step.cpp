@@ -10,6 +10,8 @@
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
 // capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
+// BM_CoiledRope/<plain|self_collision>/<nodes>: a rope laid to and fro, settled on the floor, without and
+// with self-collision (self_contacts.h), 1000 to 100,000 nodes.
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
 #include <cmath>
@@ -272,6 +274,50 @@ void BM_LoadedRope(benchmark::State& bench, bool over_capsule)
   bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
 }
 
+/// A rope of `nodes` nodes (1 cm links, radius 3 mm) laid to and fro in rows of 1 m, 1.5 cm apart, 2 cm
+/// above the floor, dropped onto it (its turns fall onto its rows): the same density at any length. With
+/// or without self-collision (self_contacts.h).
+SceneDef coiledRope(int nodes, bool self_collision)
+{
+  const double link = 0.01, spacing = 0.015;
+  const int per_row = 100;
+  RopeDef rope;
+  rope.nodes = nodes;
+  rope.mass = 0.05 * nodes * link;
+  rope.stiffness = 1e4;
+  rope.damping = 0.05;
+  rope.radius = 0.003;
+  BodyDef body = buildRope("rope", rope);
+  for (int i = 0; i < nodes; ++i)
+  {
+    const int row = i / per_row, k = i % per_row;
+    const double along = (row % 2 == 0 ? k : per_row - 1 - k) * link;
+    body.nodes[static_cast<std::size_t>(i)].position = Vec3(along, row * spacing, 0.02 + 0.01 * (row % 2));
+  }
+  for (SpringDef& spring : body.springs)
+    spring.rest_length.reset();
+  body.self_collision = self_collision;
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  scene.bodies.push_back(body);
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  return scene;
+}
+
+void BM_CoiledRope(benchmark::State& bench, bool self_collision)
+{
+  World world = buildWorld(coiledRope(static_cast<int>(bench.range(0)), self_collision));
+  for (int n = 0; n < 60; ++n)  // one second: the coil settles on the floor
+    world.step();
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
+}
+
 /// Node counts from 100 to 100,000, two per decade.
 void clothSizes(benchmark::internal::Benchmark* bench)
 {
@@ -296,6 +342,8 @@ BENCHMARK_CAPTURE(BM_RopeOnColliders, sphere, Shape::Sphere)->Args({ 1000, 0 })-
 BENCHMARK_CAPTURE(BM_RopeOnColliders, capsule, Shape::Capsule)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, box, Shape::Box)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, mesh_10k_triangles, Shape::Mesh)->Args({ 1000, 10 });
+BENCHMARK_CAPTURE(BM_CoiledRope, plain, false)->Arg(1000)->Arg(10000)->Arg(100000);
+BENCHMARK_CAPTURE(BM_CoiledRope, self_collision, true)->Arg(1000)->Arg(10000)->Arg(100000);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
 

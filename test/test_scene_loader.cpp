@@ -1108,6 +1108,21 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
                    "bad.yaml:1: bodies[0].radius", { "radius must be >= 0", "-0.1" });
 }
 
+TEST(SceneLoader, RopeSelfCollisionIsReadAndNeedsARadius)
+{
+  const std::string rope = "bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, "
+                           "stiffness: 1";
+  const SceneDef scene = parseScene(rope + ", radius: 0.005, self_collision: true}]\n", "rope.yaml");
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  EXPECT_TRUE(scene.bodies[0].self_collision);
+  EXPECT_TRUE(buildWorld(scene).model().bodies[0].self_collision);
+  EXPECT_FALSE(parseScene(rope + ", radius: 0.005}]\n", "rope.yaml").bodies[0].self_collision);
+  expectSceneError(rope + ", self_collision: true}]\n", "bad.yaml:1: bodies[0].self_collision",
+                   { "needs radius > 0" });
+  expectSceneError(rope + ", radius: 0.005, self_collision: sometimes}]\n", "bad.yaml:1: bodies[0].self_collision",
+                   { "sometimes" });
+}
+
 TEST(SceneLoader, BadMeshCollidersAreRejectedWithOneLineAtTheKey)
 {
   const std::string body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";

@@ -110,7 +110,7 @@ World buildWorld(const SceneDef& scene)
     }
     if (body.controller)
       controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });
-    model.bodies.push_back({ body.name, first, count });
+    model.bodies.push_back({ body.name, first, count, body.self_collision });
     first += count;
   }
   StepSettings step = scene.physics.step;

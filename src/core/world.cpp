@@ -19,6 +19,7 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
   , anchors_(model_.anchors.size())
   , integrators_(integrator, model_.bodies.size())
   , contacts_(model_)
+  , self_contacts_(model_)
   , material_(model_)
   , guard_(state_, model_.bodies.size())
 {
@@ -49,6 +50,7 @@ void World::step()
       moveAnchors(h);
     integrate(h);
     resolveContacts(h);
+    resolveSelfContacts();
   }
   landKinematics();
   ++steps_;
@@ -81,6 +83,12 @@ void World::integrate(double h)
 void World::resolveContacts(double h)
 {
   if (contacts_.resolve(model_, state_, h))
+    integrators_.invalidate();
+}
+
+void World::resolveSelfContacts()
+{
+  if (self_contacts_.resolve(model_, state_))
     integrators_.invalidate();
 }
 

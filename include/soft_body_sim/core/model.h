@@ -59,6 +59,7 @@ struct BodyRange
   std::string name;
   int first = 0;
   int count = 0;
+  bool self_collision = false;  ///< its links keep apart by their radii (self_contacts.h)
 };
 
 /// A named node of a body that the caller moves kinematically (its node is pinned).

@@ -82,6 +82,9 @@ struct BodyDef
   /// Pairs of node indices within the body whose segment collides as a whole (a rope's links), not
   /// only at its ends.
   std::vector<std::pair<int, int>> contact_segments;
+  /// Its contact segments keep apart from each other and from those of other such bodies
+  /// (self_contacts.h); needs contact_radius > 0.
+  bool self_collision = false;
 };
 
 struct PhysicsDef

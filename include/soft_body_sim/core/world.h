@@ -16,6 +16,7 @@
 #include "soft_body_sim/core/integrator_groups.h"
 #include "soft_body_sim/core/material.h"
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/self_contacts.h"
 
 namespace soft_body_sim
 {
@@ -145,6 +146,8 @@ private:
   void moveAnchors(double h);
   void integrate(double h);
   void resolveContacts(double h);
+  /// Links of the bodies with self_collision keep apart.
+  void resolveSelfContacts();
   /// Anchors and path-driven colliders land on their goals.
   void landKinematics();
   /// Checks every body, restores and treats the diverged ones, keeps the good state.
@@ -162,6 +165,7 @@ private:
   AnchorSet anchors_;
   IntegratorGroups integrators_;
   ContactStage contacts_;
+  SelfContacts self_contacts_;
   MaterialScaling material_;
   DivergenceGuard guard_;
   StateObserver integration_observer_;

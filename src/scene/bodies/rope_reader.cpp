@@ -7,7 +7,7 @@ namespace soft_body_sim::scene_yaml
 BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nodes", "from", "to", "mass", "stiffness", "damping", "bending",
-                                              "bending_damping", "pinned", "radius" }));
+                                              "bending_damping", "pinned", "radius", "self_collision" }));
   RopeDef rope;
   const Field nodes = requiredKey(ctx, field, "nodes");
   rope.nodes = readCount(ctx, nodes, 2);
@@ -29,7 +29,16 @@ BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& s
     rope.pinned = readPinned(ctx, *value, rope.nodes);
   if (const std::optional<Field> value = optionalKey(field, "radius"))
     rope.radius = readNumber(ctx, *value);
-  return buildBody(ctx, field, rope, buildRope);
+  bool self_collision = false;
+  if (const std::optional<Field> value = optionalKey(field, "self_collision"))
+  {
+    self_collision = readBool(ctx, *value);
+    if (self_collision && !(rope.radius > 0.0))
+      ctx.fail(*value, "needs radius > 0: links without thickness cannot keep apart");
+  }
+  BodyDef body = buildBody(ctx, field, rope, buildRope);
+  body.self_collision = self_collision;
+  return body;
 }
 
 }  // namespace soft_body_sim::scene_yaml

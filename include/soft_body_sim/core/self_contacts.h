@@ -1,0 +1,105 @@
+// The self-contact stage of a step: the links of bodies that ask for it (`self_collision`, ropes) keep
+// apart by their radii, within a body and between such bodies, so that a rope can lie on itself and coil
+// instead of passing through itself. A scene in which no body asks has no pass here and pays nothing.
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+/// A uniform grid hashed into a table (a spatial hash, Teschner et al. 2003, "Optimized Spatial Hashing
+/// for Collision Detection of Deformable Objects"), over segments: each segment sits in the cell of its
+/// midpoint, and with cells at least as wide as the longest segment plus the two largest radii, two
+/// segments that come within their radii of each other sit in the same or neighbouring cells. Built by a
+/// counting sort each time: no allocation once its arrays have grown to the segment count.
+class SegmentGrid
+{
+public:
+  /// Sorts `segments` (node index pairs into `x`) into cells of width `cell` [m] (> 0).
+  void build(const NodeArray& x, const std::vector<std::pair<int, int>>& segments, double cell);
+
+  /// Calls visit(s, t) once for every pair s < t of segments in the same or neighbouring cells (and some
+  /// more, whose cells share a slot of the table): a superset of the pairs within `cell` of each other.
+  template <typename Visit>
+  void forEachNearPair(Visit visit) const;
+
+private:
+  std::int64_t slot(std::int64_t i, std::int64_t j, std::int64_t k) const;
+
+  std::vector<std::int32_t> coordinate_;  ///< per segment: its cell's i, j, k
+  std::vector<std::uint32_t> start_;      ///< per slot: where its segments begin in sorted_
+  std::vector<std::uint32_t> sorted_;     ///< segment indices sorted by slot
+  std::vector<std::uint32_t> slot_of_;    ///< per segment: its slot
+  std::vector<std::uint32_t> cursor_;     ///< per slot: the next free place while sorting
+};
+
+template <typename Visit>
+void SegmentGrid::forEachNearPair(Visit visit) const
+{
+  const std::size_t count = slot_of_.size();
+  for (std::size_t s = 0; s < count; ++s)
+  {
+    const std::int32_t* c = &coordinate_[3 * s];
+    // The 27 cells around s's, each non-empty slot looked at once even if two of them share it.
+    std::int64_t seen[27];
+    int seen_count = 0;
+    for (int di = -1; di <= 1; ++di)
+      for (int dj = -1; dj <= 1; ++dj)
+        for (int dk = -1; dk <= 1; ++dk)
+        {
+          const std::int64_t slot_index = slot(c[0] + di, c[1] + dj, c[2] + dk);
+          const std::size_t slot_u = static_cast<std::size_t>(slot_index);
+          if (start_[slot_u] == start_[slot_u + 1])
+            continue;  // empty: most of them, and nothing to tell apart
+          bool repeated = false;
+          for (int q = 0; q < seen_count; ++q)
+            repeated = repeated || seen[q] == slot_index;
+          if (repeated)
+            continue;
+          seen[seen_count++] = slot_index;
+          for (std::uint32_t e = start_[slot_u]; e < start_[slot_u + 1]; ++e)
+            if (sorted_[e] > s)
+              visit(s, static_cast<std::size_t>(sorted_[e]));
+        }
+  }
+}
+
+/// Segment-against-segment contact of the bodies with `self_collision` (BodyRange).
+class SelfContacts
+{
+public:
+  explicit SelfContacts(const Model& model);
+
+  /// True if no body asks for self-collision: resolve() does nothing.
+  bool empty() const { return segments_.empty(); }
+
+  /// After a sub-step's integration and colliders: every two links closer than their radii together
+  /// (not neighbours along one rope, see kSkippedLinks) are pushed apart along the line between their
+  /// nearest points, the correction shared by their four nodes in proportion to their inverse masses and
+  /// weights there, and their approach speed along that line removed; kPasses times. True if any pair
+  /// touched.
+  bool resolve(const Model& model, State& state);
+
+  /// Two links of one body whose first nodes are this many places apart or fewer never collide: a rope
+  /// bent back on itself within a few links touches itself at its joints already.
+  static constexpr int kSkippedLinks = 2;
+  /// Gauss-Seidel passes over the touching pairs per sub-step: a link pressed from several sides at once
+  /// (a pile) needs more than one.
+  static constexpr int kPasses = 4;
+
+private:
+  std::vector<std::pair<int, int>> segments_;  ///< global node pairs of the colliding links
+  std::vector<int> body_;                      ///< per segment: its body
+  std::vector<double> radius_;                 ///< per segment: its nodes' mean contact radius [m]
+  double largest_radius_ = 0.0;                ///< [m]
+  NodeArray middle_;                           ///< per segment: its midpoint this sub-step [m]
+  std::vector<double> half_;                   ///< per segment: half its length this sub-step [m]
+  SegmentGrid grid_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> near_;  ///< the pairs that may touch this sub-step
+};
+
+}  // namespace soft_body_sim
