@@ -80,6 +80,8 @@ void SegmentGrid::build(const NodeArray& x, const std::vector<std::pair<int, int
 
 SelfContacts::SelfContacts(const Model& model)
 {
+  if (model.contact_radius.size() != model.nodeCount())
+    return;  // a model made without radii (World gives it zeros): points, which do not collide
   for (const auto& [a, b] : model.contact_segments)
   {
     const std::size_t body = model.bodyOf(a);
