@@ -1108,7 +1108,7 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
                    "bad.yaml:1: bodies[0].radius", { "radius must be >= 0", "-0.1" });
 }
 
-TEST(SceneLoader, RopeSelfCollisionIsReadAndNeedsARadius)
+TEST(SceneLoader, RopeSelfCollisionAndFrictionAreReadAndNeedARadius)
 {
   const std::string rope = "bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, "
                            "stiffness: 1";
@@ -1121,6 +1121,33 @@ TEST(SceneLoader, RopeSelfCollisionIsReadAndNeedsARadius)
                    { "needs radius > 0" });
   expectSceneError(rope + ", radius: 0.005, self_collision: sometimes}]\n", "bad.yaml:1: bodies[0].self_collision",
                    { "sometimes" });
+  const SceneDef rough = parseScene(rope + ", radius: 0.005, self_collision: true, self_friction: 0.4}]\n", "r.yaml");
+  EXPECT_EQ(buildWorld(rough).model().bodies[0].self_friction, 0.4);
+  EXPECT_EQ(scene.bodies[0].self_friction, 0.0);
+  expectSceneError(rope + ", radius: 0.005, self_friction: 0.4}]\n", "bad.yaml:1: bodies[0].self_friction",
+                   { "needs self_collision: true" });
+  expectSceneError(rope + ", radius: 0.005, self_collision: true, self_friction: -0.1}]\n",
+                   "bad.yaml:1: bodies[0].self_friction", { ">= 0" });
+}
+
+// A rope laid along a path: an L of two 1 m legs, 5 nodes at equal arc lengths of 0.5 m, the middle one
+// at the corner; its links at rest as laid. Errors: from/to with path, fewer than 2 points, a repeated
+// point (no length between them), each at its key.
+TEST(SceneLoader, RopePathLaysTheNodesAtEqualArcLengths)
+{
+  const std::string rope = "bodies: [{name: r, type: rope, nodes: 5, mass: 1, stiffness: 1, ";
+  const World world = buildWorld(parseScene(rope + "path: [[0, 0, 1], [1, 0, 1], [1, 1, 1]]}]\n", "r.yaml"));
+  const NodeArray& x = world.state().position;
+  const Vec3 expected[5] = { { 0, 0, 1 }, { 0.5, 0, 1 }, { 1, 0, 1 }, { 1, 0.5, 1 }, { 1, 1, 1 } };
+  for (int i = 0; i < 5; ++i)
+    EXPECT_NEAR((x.col(i) - expected[i]).norm(), 0.0, 1e-12) << "node " << i;
+  for (const Spring& spring : world.model().springs)
+    EXPECT_NEAR(spring.rest_length, 0.5, 1e-12);
+  expectSceneError(rope + "path: [[0, 0, 1], [1, 0, 1]], from: [0, 0, 1]}]\n", "bad.yaml:1: bodies[0].from",
+                   { "either from and to, or path" });
+  expectSceneError(rope + "path: [[0, 0, 1]]}]\n", "bad.yaml:1: bodies[0].path", { "at least 2 points" });
+  expectSceneError(rope + "path: [[0, 0, 1], [0, 0, 1], [1, 0, 1]]}]\n", "bad.yaml:1: bodies[0].path",
+                   { "path point 1 repeats the one before it" });
 }
 
 TEST(SceneLoader, BadMeshCollidersAreRejectedWithOneLineAtTheKey)

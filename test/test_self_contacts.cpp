@@ -4,6 +4,8 @@
 // through itself.
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
 #include <random>
 #include <set>
 #include <utility>
@@ -13,6 +15,7 @@
 
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/self_contacts.h"
+#include "soft_body_sim/scene/scene_loader.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test
@@ -20,6 +23,7 @@ namespace soft_body_sim::test
 namespace
 {
 constexpr double kPi = 3.14159265358979323846;
+constexpr double kGravity = 9.81;  // [m/s^2], PhysicsDef's default
 
 /// The distance [m] between segments p0-p1 and q0-q1: the nearest point of q's segment to each of 401
 /// points along p's (a projection clamped to the segment, exact), minimised; within (|p| / 400)^2 / (8 r)
@@ -149,6 +153,459 @@ TEST(SelfContacts, ACoiledRopeDroppedOnTheFloorNeverPassesThroughItself)
     else
       EXPECT_LT(closest, 0.5 * diameter);
   }
+}
+
+
+// --- friction between links: a rope in a tilted groove ---------------------------------------------------
+
+/// Two straight rails (ropes pinned at every node, `rail_nodes` of them) 2 m long, tilted by theta about the y axis, downhill
+/// towards +x, and a free rope 0.3 m long lying in the groove between them: every rope 5 mm in radius,
+/// the rails 2 r sin(alpha) either side of the free rope's axis so that it touches them along normals at
+/// alpha = 45 degrees from the groove's upward normal. Coulomb friction `friction` on every rope.
+SceneDef ropeInAGroove(double theta, double friction, int rail_nodes)
+{
+  const double radius = 0.005, alpha = kPi / 4.0;
+  const Vec3 down(std::cos(theta), 0.0, -std::sin(theta)), up(std::sin(theta), 0.0, std::cos(theta));
+  const Vec3 side = Vec3::UnitY() * 2.0 * radius * std::sin(alpha);
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  for (const double sign : { -1.0, 1.0 })
+  {
+    RopeDef rail;
+    rail.nodes = rail_nodes;
+    rail.from = sign * side;
+    rail.to = rail.from + 2.0 * down;
+    rail.mass = 1.0;
+    rail.stiffness = 1e4;
+    rail.radius = radius;
+    for (int i = 0; i < rail.nodes; ++i)
+      rail.pinned.push_back(i);
+    BodyDef body = buildRope(sign < 0 ? "left_rail" : "right_rail", rail);
+    body.self_collision = true;
+    body.self_friction = friction;
+    scene.bodies.push_back(body);
+  }
+  RopeDef rope;
+  rope.nodes = 16;
+  rope.from = 2.0 * radius * std::cos(alpha) * up + 0.2 * down;
+  rope.to = rope.from + 0.3 * down;
+  rope.mass = 0.03;
+  rope.stiffness = 1e4;
+  rope.damping = 0.01;
+  rope.radius = radius;
+  BodyDef body = buildRope("rope", rope);
+  body.self_collision = true;
+  body.self_friction = friction;
+  scene.bodies.push_back(body);
+  return scene;
+}
+
+// A body in a V-groove, its two contact normals at alpha either side of the groove's normal, is pressed on
+// each side by N = m g cos(theta) / (2 cos(alpha)): it stays put while tan(theta) < mu / cos(alpha) and
+// otherwise slides with a = g (sin(theta) - mu cos(theta) / cos(alpha)) (the tilted plane's closed form
+// with the wedge's larger normal force). mu = 0.3, alpha = 45 degrees: the bound is tan(theta) = 0.424.
+// At 0.8 times it the rope stays within 1 mm in 1 s; at 1.2 times it slides 0.37 m, and the friction
+// coefficient that its slide implies is mu within 5 %. That error depends on how the rails' joints fall
+// under the rope's (-2.5 % to +4.3 % for rail links of 1, 2, 2.5 and 5 cm under a rope of 2 cm links):
+// where a link lies along a chain of others, its pairs with the two links meeting at a joint share one
+// contact, and the share moves as the rope slides past the joint. Closer to the bound, at 0.9 times it,
+// the rope creeps by ~2 mm/s at 8 sub-steps (1 mm/s at 16): each contact holds its own share, and a link
+// short of its share in a sub-step slips before its neighbours' surplus reaches it through the chain.
+TEST(SelfContacts, ARopeInATiltedGrooveHoldsBelowTheWedgeFrictionAngleAndSlidesAtTheClosedFormAbove)
+{
+  const double mu = 0.3, alpha = kPi / 4.0, bound = mu / std::cos(alpha);
+  for (const int rail_nodes : { 41, 81, 101, 201 })
+    for (const double factor : { 0.8, 1.2 })
+    {
+      SCOPED_TRACE("rails of " + std::to_string(rail_nodes) + " nodes, tan(theta) = " + std::to_string(factor) +
+                   " x the bound");
+      const double theta = std::atan(factor * bound);
+      World world = buildWorld(ropeInAGroove(theta, mu, rail_nodes));
+      const int first = 2 * rail_nodes;
+      const Vec3 down(std::cos(theta), 0.0, -std::sin(theta));
+      const auto centre = [&] { return Vec3(world.state().position.middleCols(first, 16).rowwise().mean()); };
+      const Vec3 start = centre();
+      const int steps = 60;
+      for (int n = 0; n < steps; ++n)
+      {
+        world.step();
+        ASSERT_TRUE(world.takeDivergenceEvents().empty());
+      }
+      const double slid = (centre() - start).dot(down);
+      const double t = steps / 60.0;
+      if (factor < 1.0)
+      {
+        EXPECT_LT(std::abs(slid), 1e-3);
+      }
+      else
+      {
+        const double implied =
+            (std::sin(theta) - 2.0 * slid / (t * t) / kGravity) * std::cos(alpha) / std::cos(theta);
+        RecordProperty("implied_friction_" + std::to_string(rail_nodes), std::to_string(implied));
+        EXPECT_NEAR(implied, mu, 0.05 * mu);
+      }
+      // In the groove, not through a rail: the rope's axis stays on the groove's centre line.
+      for (int i = first; i < first + 16; ++i)
+        EXPECT_NEAR(world.state().position(1, i), 0.0, 1e-3);
+    }
+}
+
+
+// --- two ropes across each other ------------------------------------------------------------------------
+
+/// Rope A along y lies on a floor (friction 0.2); rope B along x lies across it, 1 cm above. In 0.5 s
+/// B's two anchored ends come down to the floor and 5 cm in each (B drapes over A), then both move 0.2 m
+/// along B's axis in 1 s, and stop. Every rope 5 mm in radius with 1 cm links, friction `friction`
+/// between the two.
+SceneDef crossedRopes(double friction)
+{
+  const double radius = 0.005;
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.2 });
+  RopeDef lower;
+  lower.nodes = 101;
+  lower.from = Vec3(0.0, -0.5, radius);
+  lower.to = Vec3(0.0, 0.5, radius);
+  lower.mass = 0.05;
+  lower.stiffness = 1e4;
+  lower.damping = 0.01;
+  lower.radius = radius;
+  RopeDef upper = lower;
+  upper.from = Vec3(-0.5, 0.0, 3.0 * radius);
+  upper.to = Vec3(0.5, 0.0, 3.0 * radius);
+  upper.mass = 0.2;
+  for (BodyDef body : { buildRope("lower", lower), buildRope("upper", upper) })
+  {
+    body.self_collision = true;
+    body.self_friction = friction;
+    if (body.name == "upper")
+      body.anchors = { AnchorDef("left", 0), AnchorDef("right", upper.nodes - 1) };
+    scene.bodies.push_back(body);
+  }
+  return scene;
+}
+
+/// Where B's end anchored at `start` is at time t: see crossedRopes.
+std::optional<Vec3> draped(const Vec3& start, double inwards, double t)
+{
+  const double lowered = std::min(t, 0.5) / 0.5, pulled = std::clamp(t - 0.5, 0.0, 1.0);
+  return start + Vec3(inwards * lowered + 0.2 * pulled, 0.0, -0.01 * lowered);
+}
+
+// Pulled along its own axis, the upper rope drags the lower one, under the crossing, along with it by
+// friction: with friction 0.5 the lower rope's middle node moves at least 0.8 times as far as the
+// upper rope's middle (observed 1.0). Without friction it still moves, 0.4 times as far: a rope of
+// straight links lies over another as a polygon, its corners catch the rope under it like teeth, and
+// only the floor's friction holds that back (with a frictionless floor both ropes move as one). The two
+// never pass through each other (the least distance between their links stays above 0.9 diameters).
+TEST(SelfContacts, ARopePulledAlongItsAxisDragsARopeLyingUnderItByFriction)
+{
+  std::map<double, double> followed;
+  for (const double friction : { 0.5, 0.0 })
+  {
+    SCOPED_TRACE("friction " + std::to_string(friction));
+    World world = buildWorld(crossedRopes(friction));
+    const Vec3 left = world.state().position.col(101), right = world.state().position.col(201);
+    world.followPath(0, [=](double t) { return draped(left, 0.05, t); });
+    world.followPath(1, [=](double t) { return draped(right, -0.05, t); });
+    const double lower_start = world.state().position(0, 50), upper_start = world.state().position(0, 151);
+    double closest = 1e300;
+    for (int n = 0; n < 120; ++n)
+    {
+      world.step();
+      ASSERT_TRUE(world.takeDivergenceEvents().empty());
+      if (n % 3 != 2)
+        continue;  // every third step (20 Hz): brute force is slow under the sanitizers
+      const NodeArray& x = world.state().position;
+      for (int i = 0; i < 100; ++i)
+        for (int j = 101; j < 201; ++j)
+          closest = std::min(closest, segmentDistance(x.col(i), x.col(i + 1), x.col(j), x.col(j + 1)));
+    }
+    followed[friction] =
+        (world.state().position(0, 50) - lower_start) / (world.state().position(0, 151) - upper_start);
+    RecordProperty(friction > 0.0 ? "followed_with_friction" : "followed_without", std::to_string(followed[friction]));
+    EXPECT_GE(closest, 0.9 * 0.01);
+  }
+  EXPECT_GE(followed[0.5], 0.8);
+  EXPECT_LT(followed[0.0], 0.5 * followed[0.5]);
+}
+
+// --- an overhand knot pulled tight -------------------------------------------------------------------------
+
+/// A point of the trefoil knot (sin t + 2 sin 2t, cos t - 2 cos 2t, -sin 3t).
+Vec3 trefoil(double t)
+{
+  return Vec3(std::sin(t) + 2.0 * std::sin(2.0 * t), std::cos(t) - 2.0 * std::cos(2.0 * t), -std::sin(3.0 * t));
+}
+
+/// An overhand knot as a polyline of links `link` [m] long: the trefoil scaled by 2 cm with one lobe's
+/// tip (t = pi, at -y) cut out (t within 0.5 of it), and from the two cut ends tails that turn away from
+/// each other (quadratic Bezier curves, 4 cm down and 4 cm out) and run 0.25 m along +x and -x. 114
+/// nodes for 1 cm links; no two links more than 3 apart come closer than 2.4 cm.
+std::vector<Vec3> overhandKnot(double link)
+{
+  const double scale = 0.02, cut = 0.5, tail = 0.25, turn = 0.04;
+  const Vec3 down(0.0, -turn, 0.0);
+  std::vector<Vec3> dense;
+  const auto addTail = [&](const Vec3& end, double side, bool outwards) {
+    std::vector<Vec3> points;
+    for (int k = 0; k <= 400; ++k)
+    {
+      const double u = k / 400.0;  // the Bezier curve end -> end + down -> end + down + side turn
+      points.push_back((1 - u) * (1 - u) * end + 2 * u * (1 - u) * (end + down) + u * u * (end + down + side * turn * Vec3::UnitX()));
+    }
+    for (int k = 1; k <= 200; ++k)
+      points.push_back(points[400] + side * tail * k / 200.0 * Vec3::UnitX());
+    if (!outwards)
+      std::reverse(points.begin(), points.end());
+    dense.insert(dense.end(), points.begin(), points.end());
+  };
+  const int samples = 20000;
+  addTail(scale * trefoil(kPi + cut), 1.0, false);
+  for (int k = 1; k < samples; ++k)
+    dense.push_back(scale * trefoil(kPi + cut + (2.0 * kPi - 2.0 * cut) * k / samples));
+  addTail(scale * trefoil(3.0 * kPi - cut), -1.0, true);
+  // Resampled at equal arc lengths.
+  std::vector<double> along{ 0.0 };
+  for (std::size_t k = 1; k < dense.size(); ++k)
+    along.push_back(along.back() + (dense[k] - dense[k - 1]).norm());
+  const int links = static_cast<int>(std::lround(along.back() / link));
+  std::vector<Vec3> nodes;
+  std::size_t k = 1;
+  for (int i = 0; i <= links; ++i)
+  {
+    const double s = along.back() * i / links;
+    while (k + 1 < dense.size() && along[k] < s)
+      ++k;
+    const double u = std::clamp((s - along[k - 1]) / (along[k] - along[k - 1]), 0.0, 1.0);
+    nodes.push_back(dense[k - 1] + u * (dense[k] - dense[k - 1]));
+  }
+  return nodes;
+}
+
+/// A crossing of the knot's diagram: where, along the closed polyline, it passes over and under.
+struct Crossing
+{
+  double over, under;  ///< positions along the polyline: segment index + fraction
+};
+
+/// The crossings of the polyline `nodes` in its projection on the xy plane, closed far outside it by a
+/// path that crosses nothing: from each end straight out (away from the centroid) to ten times the
+/// polyline's reach, joined by an arc there. The ends must be outermost along those lines, as a knot's
+/// pulled tails are.
+std::vector<Crossing> crossings(std::vector<Vec3> nodes)
+{
+  Vec3 centre = Vec3::Zero();
+  for (const Vec3& node : nodes)
+    centre += node / static_cast<double>(nodes.size());
+  double reach = 0.0;
+  for (const Vec3& node : nodes)
+    reach = std::max(reach, (node - centre).head<2>().norm());
+  const auto angle = [&](const Vec3& node) { return std::atan2(node.y() - centre.y(), node.x() - centre.x()); };
+  const double from = angle(nodes.back());
+  double to = angle(nodes.front());
+  if (to < from)
+    to += 2.0 * kPi;
+  for (int k = 0; k <= 64; ++k)
+  {
+    const double a = from + (to - from) * k / 64.0;
+    nodes.push_back(centre + 10.0 * reach * Vec3(std::cos(a), std::sin(a), 0.0));
+  }
+  const int count = static_cast<int>(nodes.size());  // segment k joins node k to node (k + 1) % count
+  std::vector<Crossing> found;
+  for (int a = 0; a < count; ++a)
+    for (int b = a + 2; b < count; ++b)
+    {
+      if (a == 0 && b == count - 1)
+        continue;  // neighbours round the closing point
+      const Vec3 p = nodes[static_cast<std::size_t>(a)], q = nodes[static_cast<std::size_t>(b)];
+      const Vec3 dp = nodes[static_cast<std::size_t>((a + 1) % count)] - p;
+      const Vec3 dq = nodes[static_cast<std::size_t>((b + 1) % count)] - q;
+      const double denominator = dp.x() * dq.y() - dp.y() * dq.x();
+      if (denominator == 0.0)
+        continue;
+      const Vec3 r = q - p;
+      const double u = (r.x() * dq.y() - r.y() * dq.x()) / denominator;
+      const double v = (r.x() * dp.y() - r.y() * dp.x()) / denominator;
+      if (u < 0.0 || u >= 1.0 || v < 0.0 || v >= 1.0)
+        continue;
+      const bool a_over = p.z() + u * dp.z() > q.z() + v * dq.z();
+      found.push_back(a_over ? Crossing{ a + u, b + v } : Crossing{ b + v, a + u });
+    }
+  return found;
+}
+
+/// The determinant of the knot that `nodes` make when closed as in crossings(): |det| of the diagram's
+/// colouring matrix with one row and column removed (each crossing: 2 x its over-arc - its two
+/// under-arcs; arcs end where the curve passes under). A knot invariant: 1 for the unknot, 3 for the
+/// trefoil (the overhand knot closed), whatever the diagram (Livingston, Knot Theory, 3.4).
+long knotDeterminant(const std::vector<Vec3>& nodes)
+{
+  const std::vector<Crossing> found = crossings(nodes);
+  const int n = static_cast<int>(found.size());
+  if (n == 0)
+    return 1;
+  std::vector<double> unders;
+  for (const Crossing& c : found)
+    unders.push_back(c.under);
+  std::sort(unders.begin(), unders.end());
+  // Arc k runs from the k-th passage under to the next (cyclically): the arc through position s.
+  const auto arc = [&](double s) {
+    const long before = std::upper_bound(unders.begin(), unders.end(), s) - unders.begin();
+    return static_cast<int>((before - 1 + n) % n);
+  };
+  Eigen::MatrixXd colouring = Eigen::MatrixXd::Zero(n, n);
+  for (int c = 0; c < n; ++c)
+  {
+    const Crossing& crossing = found[static_cast<std::size_t>(c)];
+    const int leaving = arc(crossing.under);
+    colouring(c, arc(crossing.over)) += 2.0;
+    colouring(c, leaving) -= 1.0;
+    colouring(c, (leaving - 1 + n) % n) -= 1.0;
+  }
+  if (n == 1)
+    return 1;
+  return std::lround(std::abs(colouring.bottomRightCorner(n - 1, n - 1).determinant()));
+}
+
+// The determinant tells the knots apart: 3 for the overhand knot, 1 for a rope in a helix (coiled but
+// not knotted) and for a straight one.
+TEST(KnotDeterminant, IsThreeForTheOverhandKnotAndOneForUnknottedRopes)
+{
+  EXPECT_EQ(knotDeterminant(overhandKnot(0.01)), 3);
+  std::vector<Vec3> helix, straight;
+  for (int i = 0; i <= 200; ++i)
+  {
+    const double t = i / 200.0;
+    helix.push_back(Vec3(0.1 * std::sin(6.0 * t * 2.0 * kPi), -t, 0.1 * std::cos(6.0 * t * 2.0 * kPi)));
+    straight.push_back(Vec3(0.0, -t, 0.0));
+  }
+  EXPECT_EQ(knotDeterminant(helix), 1);
+  EXPECT_EQ(knotDeterminant(straight), 1);
+}
+
+/// The overhand knot as a rope of radius 5 mm and 1 cm links (xpbd, no gravity), its two ends anchored
+/// and pulled apart along its tails, each 0.15 m at 0.1 m/s, then held.
+SceneDef knotScene(double friction)
+{
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  scene.physics.gravity = Vec3::Zero();
+  RopeDef rope;
+  const std::vector<Vec3> shape = overhandKnot(0.01);
+  rope.nodes = static_cast<int>(shape.size());
+  rope.mass = 0.05;
+  rope.stiffness = 1e4;
+  rope.damping = 0.01;
+  rope.radius = 0.005;
+  BodyDef body = buildRope("rope", rope);
+  for (std::size_t i = 0; i < shape.size(); ++i)
+    body.nodes[i].position = shape[i];
+  for (SpringDef& spring : body.springs)
+    spring.rest_length.reset();
+  body.self_collision = true;
+  body.self_friction = friction;
+  body.anchors = { AnchorDef("start", 0), AnchorDef("end", rope.nodes - 1) };
+  scene.bodies.push_back(body);
+  return scene;
+}
+
+// Pulled tight, the overhand knot stays an overhand knot: its determinant is 3 at the end, with friction
+// 0.5 and without friction (it cannot undo itself by passing through), its links never come closer than
+// 0.9 diameters (observed 0.997), and it tightens (the rope in the knot shortens to less than half).
+TEST(SelfContacts, AnOverhandKnotPulledTightStaysAKnot)
+{
+  for (const double friction : { 0.5, 0.0 })
+  {
+    SCOPED_TRACE("friction " + std::to_string(friction));
+    World world = buildWorld(knotScene(friction));
+    const int nodes = world.model().nodeCount();
+    const Vec3 start = world.state().position.col(0), end = world.state().position.col(nodes - 1);
+    world.followPath(0, [=](double t) { return std::optional<Vec3>(start + Vec3::UnitX() * 0.1 * std::min(t, 1.5)); });
+    world.followPath(1, [=](double t) { return std::optional<Vec3>(end - Vec3::UnitX() * 0.1 * std::min(t, 1.5)); });
+    // The length of rope in the knot: from the first to the last link that passes within 3 cm of a link
+    // more than 5 places away (the tails, straight and apart, have none).
+    const auto knotLength = [&] {
+      const NodeArray& x = world.state().position;
+      int first = nodes, last = -1;
+      for (int i = 0; i + 1 < nodes; ++i)
+        for (int j = 0; j + 1 < nodes; ++j)
+          if (std::abs(i - j) > 5 && segmentDistance(x.col(i), x.col(i + 1), x.col(j), x.col(j + 1)) < 0.03)
+          {
+            first = std::min(first, i);
+            last = std::max(last, i);
+            break;
+          }
+      return (last - first + 1) * 0.01;
+    };
+    const double loose = knotLength();
+    double closest = 1e300;
+    for (int n = 0; n < 150; ++n)
+    {
+      world.step();
+      ASSERT_TRUE(world.takeDivergenceEvents().empty());
+      if (n % 3 == 2)  // every third step (20 Hz): brute force is slow under the sanitizers
+        closest = std::min(closest, closestLinks(world));
+    }
+    std::vector<Vec3> x;
+    for (int i = 0; i < nodes; ++i)
+      x.push_back(world.state().position.col(i));
+    const double tight = knotLength();
+    RecordProperty(friction > 0.0 ? "knot_closest_with_friction" : "knot_closest_without", std::to_string(closest));
+    RecordProperty(friction > 0.0 ? "knot_length_with_friction" : "knot_length_without",
+                   std::to_string(loose) + " -> " + std::to_string(tight));
+    EXPECT_EQ(knotDeterminant(x), 3);
+    EXPECT_GE(closest, 0.9 * 0.01);
+    EXPECT_LT(tight, 0.5 * loose);
+  }
+}
+
+// config/scenes/knot.yaml: the loose overhand knot in a rope hanging from its top end is pulled tight by
+// the lower tail's weight within 3 s (the rope in the knot shortens to less than 0.6 times its length),
+// stays an overhand knot (determinant 3, in the projection on the vertical xz plane, where the tails are
+// outermost) and its links keep 0.9 diameters apart.
+TEST(SelfContacts, TheKnotSceneTightensUnderItsOwnWeightAndStaysAKnot)
+{
+  World world = buildWorld(loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/knot.yaml"));
+  const int nodes = world.model().nodeCount();
+  const auto knotLength = [&] {
+    const NodeArray& x = world.state().position;
+    int first = nodes, last = -1;
+    for (int i = 0; i + 1 < nodes; ++i)
+      for (int j = 0; j + 1 < nodes; ++j)
+        if (std::abs(i - j) > 5 && segmentDistance(x.col(i), x.col(i + 1), x.col(j), x.col(j + 1)) < 0.03)
+        {
+          first = std::min(first, i);
+          last = std::max(last, i);
+          break;
+        }
+    return (last - first + 1) * 0.01;
+  };
+  const double loose = knotLength();
+  double closest = 1e300;
+  for (int n = 0; n < 180; ++n)
+  {
+    world.step();
+    ASSERT_TRUE(world.takeDivergenceEvents().empty());
+    if (n % 3 == 2)
+      closest = std::min(closest, closestLinks(world));
+  }
+  std::vector<Vec3> xz;  // (x, z, y): the diagram seen from -y
+  for (int i = 0; i < nodes; ++i)
+  {
+    const Vec3 p = world.state().position.col(i);
+    xz.push_back(Vec3(p.x(), p.z(), p.y()));
+  }
+  const double tight = knotLength();
+  RecordProperty("knot_scene_length", std::to_string(loose) + " -> " + std::to_string(tight));
+  RecordProperty("knot_scene_closest", std::to_string(closest));
+  EXPECT_EQ(knotDeterminant(xz), 3);
+  EXPECT_GE(closest, 0.9 * 0.01);
+  EXPECT_LT(tight, 0.6 * loose);
 }
 
 }  // namespace

@@ -110,7 +110,9 @@ World buildWorld(const SceneDef& scene)
     }
     if (body.controller)
       controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });
-    model.bodies.push_back({ body.name, first, count, body.self_collision });
+    if (!(body.self_friction >= 0.0))
+      throw std::invalid_argument("body '" + body.name + "': self_friction must be >= 0");
+    model.bodies.push_back({ body.name, first, count, body.self_collision, body.self_friction });
     first += count;
   }
   StepSettings step = scene.physics.step;

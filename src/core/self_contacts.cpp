@@ -3,14 +3,20 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <tuple>
 
 namespace soft_body_sim
 {
 namespace
 {
 /// The parameters s, t in [0, 1] of the nearest points of segments p0 + s d1 and q0 + t d2 (Ericson,
-/// Real-Time Collision Detection, 5.1.9).
-std::pair<double, double> nearestParameters(const Vec3& p0, const Vec3& d1, const Vec3& q0, const Vec3& d2)
+/// Real-Time Collision Detection, 5.1.9), or of the nearest among their ends and the other segment if
+/// the two are within ~10 degrees of parallel. A link lying along another (a rope in a groove, on a rope)
+/// then meets it at one of its nodes, each node pushed out by its own depth: a point inside the link
+/// (where the nearly parallel lines come closest, ill-conditioned) would push both nodes by the depth
+/// there, throwing out one that a neighbouring link had already freed, and that node, off the surface,
+/// would slip with no friction holding it.
+std::pair<double, double> contactParameters(const Vec3& p0, const Vec3& d1, const Vec3& q0, const Vec3& d2)
 {
   const Vec3 r = p0 - q0;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
@@ -22,7 +28,26 @@ std::pair<double, double> nearestParameters(const Vec3& p0, const Vec3& d1, cons
   if (!(e > 0.0))
     return { std::clamp(-c / a, 0.0, 1.0), 0.0 };
   const double b = d1.dot(d2), denominator = a * e - b * b;
-  double s = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
+  if (denominator < 0.03 * a * e)  // sin^2 of the angle between them < 0.03
+  {
+    const std::pair<double, double> ends[4] = { { 0.0, std::clamp(f / e, 0.0, 1.0) },
+                                                { 1.0, std::clamp((b + f) / e, 0.0, 1.0) },
+                                                { std::clamp(-c / a, 0.0, 1.0), 0.0 },
+                                                { std::clamp((b - c) / a, 0.0, 1.0), 1.0 } };
+    std::pair<double, double> nearest = ends[0];
+    double least = 1e300;
+    for (const auto& [s, t] : ends)
+    {
+      const double gap = (r + s * d1 - t * d2).squaredNorm();
+      if (gap < least)
+      {
+        least = gap;
+        nearest = { s, t };
+      }
+    }
+    return nearest;
+  }
+  double s = std::clamp((b * f - c * e) / denominator, 0.0, 1.0);
   double t = (b * s + f) / e;
   if (t < 0.0)
   {
@@ -91,10 +116,18 @@ SelfContacts::SelfContacts(const Model& model)
     segments_.emplace_back(a, b);
     body_.push_back(static_cast<int>(body));
     radius_.push_back(radius);
+    friction_.push_back(model.bodies[body].self_friction);
+    any_friction_ = any_friction_ || model.bodies[body].self_friction > 0.0;
     largest_radius_ = std::max(largest_radius_, radius);
   }
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
+}
+
+void SelfContacts::remember(const State& state)
+{
+  if (any_friction_)
+    start_ = state.position;
 }
 
 bool SelfContacts::resolve(const Model& model, State& state)
@@ -127,45 +160,108 @@ bool SelfContacts::resolve(const Model& model, State& state)
         bound * bound)
       return;
     const Vec3 xa = x.col(a), xc = x.col(c);
-    const auto [p, q] = nearestParameters(xa, x.col(b) - xa, xc, x.col(d) - xc);
+    const auto [p, q] = contactParameters(xa, x.col(b) - xa, xc, x.col(d) - xc);
     const double gap = ((xa + p * (x.col(b) - xa)) - (xc + q * (x.col(d) - xc))).norm();
     if (gap < 2.0 * (radius_[s] + radius_[t]))
-      near_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
+      near_.push_back({ static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t), 0.0, 0.0 });
   });
   bool touched = false;
   const Eigen::VectorXd& w = model.inverse_mass;
+  // The contact of pair k at the current positions: the nearest points' parameters, the unit normal from
+  // t's link to s's, the distance and each node's share; false if there is no direction or no free node.
+  struct Contact
+  {
+    double p, q, distance, ka, kb, kc, kd, weight;
+    Vec3 n;
+  };
+  const auto contact = [&](std::size_t s, std::size_t t, Contact& k) {
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    const Vec3 xa = x.col(a), xb = x.col(b), xc = x.col(c), xd = x.col(d);
+    std::tie(k.p, k.q) = contactParameters(xa, xb - xa, xc, xd - xc);
+    const Vec3 between = (xa + k.p * (xb - xa)) - (xc + k.q * (xd - xc));
+    k.distance = between.norm();
+    if (!(k.distance > 1e-12))
+      return false;  // crossing exactly: no direction to part them in (the next sub-step has one)
+    k.n = between / k.distance;
+    k.ka = (1.0 - k.p) * w[a];
+    k.kb = k.p * w[b];
+    k.kc = (1.0 - k.q) * w[c];
+    k.kd = k.q * w[d];
+    k.weight = (1.0 - k.p) * k.ka + k.p * k.kb + (1.0 - k.q) * k.kc + k.q * k.kd;
+    return k.weight > 0.0;
+  };
+  // Changes y (positions or velocities) of the four nodes so that the difference between the two nearest
+  // points changes by `change`, each node by its share of the inverse mass there.
+  const auto part = [&](std::size_t s, std::size_t t, const Contact& k, NodeArray& y, const Vec3& change) {
+    const Vec3 unit = change / k.weight;
+    y.col(segments_[s].first) += k.ka * unit;
+    y.col(segments_[s].second) += k.kb * unit;
+    y.col(segments_[t].first) -= k.kc * unit;
+    y.col(segments_[t].second) -= k.kd * unit;
+  };
+  const auto relativeVelocity = [&](std::size_t s, std::size_t t, const Contact& k) {
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    return Vec3((1.0 - k.p) * v.col(a) + k.p * v.col(b) - (1.0 - k.q) * v.col(c) - k.q * v.col(d));
+  };
+  // Projected Gauss-Seidel on each pair's accumulated push and speed change (Catto's accumulated
+  // impulses): a pass may take back part of what an earlier one gave, never more. A push at a point
+  // inside a link moves its nearer node by more than the depth there; without taking back, a neighbouring
+  // pair's push on that node would leave it thrown off the surface (and in a groove, off with no friction
+  // holding it).
+  Contact k;
   for (int pass = 0; pass < kPasses; ++pass)
-    for (const auto& [s, t] : near_)
+    for (NearPair& pair : near_)
     {
-      const auto [a, b] = segments_[s];
-      const auto [c, d] = segments_[t];
-      const Vec3 xa = x.col(a), xb = x.col(b), xc = x.col(c), xd = x.col(d);
-      const auto [p, q] = nearestParameters(xa, xb - xa, xc, xd - xc);
-      const Vec3 between = (xa + p * (xb - xa)) - (xc + q * (xd - xc));
-      const double distance = between.norm();
-      const double depth = radius_[s] + radius_[t] - distance;
-      if (!(depth > 0.0) || !(distance > 1e-12))
-        continue;  // apart, or crossing exactly (no direction to part them in: the next sub-step has one)
-      const Vec3 n = between / distance;
-      const double ka = (1.0 - p) * w[a], kb = p * w[b], kc = (1.0 - q) * w[c], kd = q * w[d];
-      const double weight = (1.0 - p) * ka + p * kb + (1.0 - q) * kc + q * kd;
-      if (!(weight > 0.0))
+      if (!contact(pair.s, pair.t, k))
         continue;
-      const double push = depth / weight;
-      x.col(a) += ka * push * n;
-      x.col(b) += kb * push * n;
-      x.col(c) -= kc * push * n;
-      x.col(d) -= kd * push * n;
-      const double approach = ((1.0 - p) * v.col(a) + p * v.col(b) - (1.0 - q) * v.col(c) - q * v.col(d)).dot(n);
-      if (approach < 0.0)
+      const double push = std::max(-pair.push, radius_[pair.s] + radius_[pair.t] - k.distance);
+      // Only links that touch stop approaching; others give back what they took.
+      const double stop = pair.push + push > 0.0 ? std::max(-pair.stop, -relativeVelocity(pair.s, pair.t, k).dot(k.n))
+                                                 : -pair.stop;
+      if (push != 0.0)
+        part(pair.s, pair.t, k, x, push * k.n);
+      if (stop != 0.0)
+        part(pair.s, pair.t, k, v, stop * k.n);
+      pair.push += push;
+      pair.stop += stop;
+      touched = touched || pair.push > 0.0;
+    }
+  if (!any_friction_ || !touched)
+    return touched;
+  // Coulomb friction as on a collider (contact_response.h), relative to the other link, once the links
+  // are apart: the sub-step's tangential slip of the nearest points cancelled up to friction * the push
+  // apart, their tangential speed reduced by up to friction * the approach speed removed. After the
+  // normal passes, not in them: in a groove, a link's motion into the other side is tangential at the
+  // first side's contact, and friction there would spend its budget against what the other side stops.
+  for (int pass = 0; pass < kPasses; ++pass)
+    for (NearPair& pair : near_)
+    {
+      const double friction = 0.5 * (friction_[pair.s] + friction_[pair.t]);
+      if (!(friction > 0.0) || !(pair.push > 0.0 || pair.stop > 0.0) || !contact(pair.s, pair.t, k))
+        continue;
+      const auto [a, b] = segments_[pair.s];
+      const auto [c, d] = segments_[pair.t];
+      const Vec3 moved = (1.0 - k.p) * (x.col(a) - start_.col(a)) + k.p * (x.col(b) - start_.col(b)) -
+                         (1.0 - k.q) * (x.col(c) - start_.col(c)) - k.q * (x.col(d) - start_.col(d));
+      const Vec3 slid = moved - moved.dot(k.n) * k.n;
+      const double slid_length = slid.norm();
+      if (slid_length > 0.0)
       {
-        const double stop = -approach / weight;
-        v.col(a) += ka * stop * n;
-        v.col(b) += kb * stop * n;
-        v.col(c) -= kc * stop * n;
-        v.col(d) -= kd * stop * n;
+        const double cancelled = std::min(slid_length, friction * pair.push);
+        part(pair.s, pair.t, k, x, -(cancelled / slid_length) * slid);
+        pair.push -= cancelled / friction;
       }
-      touched = true;
+      const Vec3 relative = relativeVelocity(pair.s, pair.t, k);
+      const Vec3 tangential = relative - relative.dot(k.n) * k.n;
+      const double tangential_speed = tangential.norm();
+      if (tangential_speed > 0.0)
+      {
+        const double slowed = std::min(tangential_speed, friction * pair.stop);
+        part(pair.s, pair.t, k, v, -(slowed / tangential_speed) * tangential);
+        pair.stop -= slowed / friction;
+      }
     }
   return touched;
 }

@@ -46,6 +46,7 @@ void World::step()
   const bool kinematic = driveKinematicNodes(dt);
   for (int substep = 0; substep < settings_.substeps; ++substep)
   {
+    self_contacts_.remember(state_);  // before the anchors move: a dragged link slips past the others
     if (kinematic)
       moveAnchors(h);
     integrate(h);

@@ -85,6 +85,9 @@ struct BodyDef
   /// Its contact segments keep apart from each other and from those of other such bodies
   /// (self_contacts.h); needs contact_radius > 0.
   bool self_collision = false;
+  /// Coulomb coefficient [-] >= 0 between its contact segments and those they touch (self_collision;
+  /// two bodies touching each other use the mean of theirs).
+  double self_friction = 0.0;
 };
 
 struct PhysicsDef

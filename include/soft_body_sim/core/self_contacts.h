@@ -77,10 +77,15 @@ public:
   /// True if no body asks for self-collision: resolve() does nothing.
   bool empty() const { return segments_.empty(); }
 
+  /// At the start of a sub-step (before anchors move): where the links start, from which friction
+  /// measures their slip. Nothing without friction.
+  void remember(const State& state);
+
   /// After a sub-step's integration and colliders: every two links closer than their radii together
   /// (not neighbours along one rope, see kSkippedLinks) are pushed apart along the line between their
   /// nearest points, the correction shared by their four nodes in proportion to their inverse masses and
-  /// weights there, and their approach speed along that line removed; kPasses times. True if any pair
+  /// weights there, their approach speed along that line removed, and Coulomb friction (the mean of the
+  /// two bodies' self_friction) acts on their slip past each other; kPasses times. True if any pair
   /// touched.
   bool resolve(const Model& model, State& state);
 
@@ -95,11 +100,21 @@ private:
   std::vector<std::pair<int, int>> segments_;  ///< global node pairs of the colliding links
   std::vector<int> body_;                      ///< per segment: its body
   std::vector<double> radius_;                 ///< per segment: its nodes' mean contact radius [m]
+  std::vector<double> friction_;               ///< per segment: its body's self_friction [-]
+  bool any_friction_ = false;
+  NodeArray start_;                            ///< positions at the sub-step's start, if any friction [m]
   double largest_radius_ = 0.0;                ///< [m]
   NodeArray middle_;                           ///< per segment: its midpoint this sub-step [m]
   std::vector<double> half_;                   ///< per segment: half its length this sub-step [m]
   SegmentGrid grid_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> near_;  ///< the pairs that may touch this sub-step
+  /// Two links that may touch this sub-step, and what friction may still spend there.
+  struct NearPair
+  {
+    std::uint32_t s, t;  ///< segment indices
+    double push;         ///< [m] the normal passes' push apart, less what friction has cancelled / mu
+    double stop;         ///< [m/s] the approach speed they removed, likewise
+  };
+  std::vector<NearPair> near_;
 };
 
 }  // namespace soft_body_sim

@@ -1,6 +1,9 @@
 #include "soft_body_sim/core/bodies/rope.h"
 
+#include <algorithm>
+#include <optional>
 #include <stdexcept>
+#include <string>
 
 namespace soft_body_sim
 {
@@ -16,21 +19,38 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
   requireDefinition(rope.bending_damping == 0.0 || rope.bending > 0.0, what, { "bending_damping" },
                     "bending_damping has no effect without bending > 0 (there are no bending springs to damp)");
   requireDefinition(rope.radius >= 0.0, what, { "radius" }, "radius must be >= 0");
-  requireDefinition((rope.to - rope.from).norm() > 0.0, what, { "to", "from" },
-                    "to must differ from 'from'; a rope needs a length");
+  if (rope.path.empty())
+    requireDefinition((rope.to - rope.from).norm() > 0.0, what, { "to", "from" },
+                      "to must differ from 'from'; a rope needs a length");
+  const std::vector<Vec3> layout = rope.path.empty() ? std::vector<Vec3>{ rope.from, rope.to } : rope.path;
+  requireDefinition(layout.size() >= 2, what, { "path" }, "path needs at least 2 points");
+  std::vector<double> along{ 0.0 };  // arc length [m] at each point of the layout
+  for (std::size_t k = 1; k < layout.size(); ++k)
+  {
+    const double length = (layout[k] - layout[k - 1]).norm();
+    requireDefinition(length > 0.0, what, { "path" },
+                      "path point " + std::to_string(k) + " repeats the one before it; a rope needs a length");
+    along.push_back(along.back() + length);
+  }
   BodyDef body;
   body.name = name;
   body.type = "rope";
   body.contact_radius = rope.radius;
   const double node_mass = rope.mass / rope.nodes;
+  std::size_t k = 1;  // the layout's segment from point k - 1 to point k holds node i
   for (int i = 0; i < rope.nodes; ++i)
   {
-    const double s = static_cast<double>(i) / (rope.nodes - 1);
-    body.nodes.push_back(NodeDef{ rope.from + s * (rope.to - rope.from), node_mass, Vec3::Zero(), false });
+    const double s = along.back() * i / (rope.nodes - 1);
+    while (k + 1 < layout.size() && along[k] < s)
+      ++k;
+    const double u = std::clamp((s - along[k - 1]) / (along[k] - along[k - 1]), 0.0, 1.0);
+    body.nodes.push_back(NodeDef{ layout[k - 1] + u * (layout[k] - layout[k - 1]), node_mass, Vec3::Zero(), false });
   }
   for (int index : rope.pinned)
     body.nodes[static_cast<std::size_t>(resolveNodeIndex(index, rope.nodes))].pinned = true;
-  // Rest lengths stay empty: the straight initial layout is the rest shape.
+  // Links' rest lengths stay empty: the initial layout is their rest shape (a path's chords, a little
+  // shorter than its arc where it bends). Bending springs rest straight: twice the mean link.
+  const double link = along.back() / (rope.nodes - 1);
   for (int i = 0; i + 1 < rope.nodes; ++i)
   {
     body.springs.push_back(SpringDef{ i, i + 1, rope.stiffness, rope.damping, std::nullopt });
@@ -38,7 +58,8 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
   }
   if (rope.bending > 0.0)
     for (int i = 0; i + 2 < rope.nodes; ++i)
-      body.springs.push_back(SpringDef{ i, i + 2, rope.bending, rope.bending_damping, std::nullopt });
+      body.springs.push_back(SpringDef{ i, i + 2, rope.bending, rope.bending_damping,
+                                        rope.path.empty() ? std::nullopt : std::optional<double>(2.0 * link) });
   return body;
 }
 

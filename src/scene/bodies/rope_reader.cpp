@@ -6,14 +6,29 @@ namespace soft_body_sim::scene_yaml
 {
 BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
-  requireMap(ctx, field, withCommonBodyKeys({ "nodes", "from", "to", "mass", "stiffness", "damping", "bending",
-                                              "bending_damping", "pinned", "radius", "self_collision" }));
+  requireMap(ctx, field, withCommonBodyKeys({ "nodes", "from", "to", "path", "mass", "stiffness", "damping", "bending",
+                                              "bending_damping", "pinned", "radius", "self_collision",
+                                              "self_friction" }));
   RopeDef rope;
   const Field nodes = requiredKey(ctx, field, "nodes");
   rope.nodes = readCount(ctx, nodes, 2);
   scene.requireNodes(ctx, nodes, rope.nodes);
-  rope.from = readVec3(ctx, requiredKey(ctx, field, "from"));
-  rope.to = readVec3(ctx, requiredKey(ctx, field, "to"));
+  if (const std::optional<Field> path = optionalKey(field, "path"))
+  {
+    for (const char* key : { "from", "to" })
+      if (const std::optional<Field> value = optionalKey(field, key))
+        ctx.fail(*value, "give either from and to, or path, not both");
+    const std::vector<Field> points = requireList(ctx, *path, "a list of at least 2 points [x, y, z]");
+    if (points.size() < 2)
+      ctx.fail(*path, "needs at least 2 points [x, y, z]");
+    for (const Field& point : points)
+      rope.path.push_back(readVec3(ctx, point));
+  }
+  else
+  {
+    rope.from = readVec3(ctx, requiredKey(ctx, field, "from"));
+    rope.to = readVec3(ctx, requiredKey(ctx, field, "to"));
+  }
   rope.mass = readNumber(ctx, requiredKey(ctx, field, "mass"));
   rope.stiffness = readNumber(ctx, requiredKey(ctx, field, "stiffness"));
   rope.damping = 0.0;
@@ -36,8 +51,16 @@ BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& s
     if (self_collision && !(rope.radius > 0.0))
       ctx.fail(*value, "needs radius > 0: links without thickness cannot keep apart");
   }
+  double self_friction = 0.0;
+  if (const std::optional<Field> value = optionalKey(field, "self_friction"))
+  {
+    self_friction = readNonNegative(ctx, *value);
+    if (!self_collision)
+      ctx.fail(*value, "needs self_collision: true: links that do not touch have no friction");
+  }
   BodyDef body = buildBody(ctx, field, rope, buildRope);
   body.self_collision = self_collision;
+  body.self_friction = self_friction;
   return body;
 }
 

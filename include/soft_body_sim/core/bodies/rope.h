@@ -14,6 +14,10 @@ struct RopeDef
   int nodes = 20;                     ///< node count, >= 2
   Vec3 from = Vec3::Zero();           ///< first node [m]
   Vec3 to = Vec3(1.0, 0.0, 0.0);      ///< last node [m]; segments start at rest, |to - from| / (nodes - 1)
+  /// If not empty, replaces from and to: the polyline [m] (>= 2 points) along which the nodes lie at
+  /// equal arc lengths, first and last node at its ends (a rope laid in a coil or a knot). Its links
+  /// start at rest as laid; bending springs keep a straight rest shape.
+  std::vector<Vec3> path;
   double mass = 0.1;                  ///< total mass [kg], spread equally over the nodes
   double stiffness = 1000.0;          ///< segment spring stiffness [N/m]
   double damping = 0.0;               ///< segment dashpot [N s/m]
