@@ -11,7 +11,8 @@
 // capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
 // BM_CoiledRope/<plain|self_collision>/<nodes>: a rope laid to and fro, settled on the floor, without and
-// with self-collision (self_contacts.h), 1000 to 100,000 nodes.
+// with self-collision (self_contacts.h), 1000 to 100,000 nodes; BM_CoiledRopeFalling the same while it
+// falls and lands (its links moving past each other: the candidate pairs found again more often).
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
 #include <cmath>
@@ -318,6 +319,29 @@ void BM_CoiledRope(benchmark::State& bench, bool self_collision)
   bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
 }
 
+/// The same rope while it falls and lands: the first 0.5 s after its release, again and again (the
+/// world rebuilt outside the timing), so that the links keep moving past each other.
+void BM_CoiledRopeFalling(benchmark::State& bench, bool self_collision)
+{
+  const SceneDef scene = coiledRope(static_cast<int>(bench.range(0)), self_collision);
+  World world = buildWorld(scene);
+  int steps = 0;
+  for (auto _ : bench)
+  {
+    if (steps == 30)
+    {
+      bench.PauseTiming();
+      world = buildWorld(scene);
+      steps = 0;
+      bench.ResumeTiming();
+    }
+    world.step();
+    ++steps;
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
+}
+
 /// Node counts from 100 to 100,000, two per decade.
 void clothSizes(benchmark::internal::Benchmark* bench)
 {
@@ -344,6 +368,8 @@ BENCHMARK_CAPTURE(BM_RopeOnColliders, box, Shape::Box)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, mesh_10k_triangles, Shape::Mesh)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_CoiledRope, plain, false)->Arg(1000)->Arg(10000)->Arg(100000);
 BENCHMARK_CAPTURE(BM_CoiledRope, self_collision, true)->Arg(1000)->Arg(10000)->Arg(100000);
+BENCHMARK_CAPTURE(BM_CoiledRopeFalling, plain, false)->Arg(1000)->Arg(10000);
+BENCHMARK_CAPTURE(BM_CoiledRopeFalling, self_collision, true)->Arg(1000)->Arg(10000);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
 

@@ -66,6 +66,8 @@ const std::vector<Pinned> kPinned = {
   { "config/scenes/jelly.yaml", "rk4", 0x2d57f2f8e08e422ULL },
   { "config/scenes/jelly.yaml", "implicit_euler", 0x3a54c1577950d024ULL },
   { "config/scenes/jelly.yaml", "xpbd", 0x1ba83e59eac5aa37ULL },
+  { "config/scenes/knot.yaml", "implicit_euler", 0x1d527071102454aULL },
+  { "config/scenes/knot.yaml", "xpbd", 0x706da1c364b8ffe6ULL },
   { "config/scenes/limb.yaml", "explicit_euler", 0x209a46a387d07860ULL },
   { "config/scenes/limb.yaml", "semi_implicit_euler", 0x209a46a387d07860ULL },
   { "config/scenes/limb.yaml", "verlet", 0x209a46a387d07860ULL },

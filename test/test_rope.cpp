@@ -322,7 +322,7 @@ const BadKeys kBadRopes[] = {
   { "PinnedCornerNameOnARope", "    nodes: 3\n" ROPE_FROM_LINE_5 "    pinned: [top_left]\n",
     "rope.yaml:9: bodies[0].pinned[0]", { "expected an integer", "'top_left'" } },
   { "UnknownKey", "    nodes: 3\n" ROPE_FROM_LINE_5 "    length: 2\n", "rope.yaml:9: bodies[0].length",
-    { "unknown key 'length'", "nodes, from, to, mass, stiffness, damping, bending, bending_damping, pinned" } },
+    { "unknown key 'length'", "nodes, from, to, path, mass, stiffness, damping, bending, bending_damping, pinned" } },
   { "AnchorOutOfRange", "    nodes: 3\n" ROPE_FROM_LINE_5 "    anchors: [{name: end, node: 3}]\n",
     "rope.yaml:9: bodies[0].anchors[0].node", { "node index 3 out of range" } },
 };

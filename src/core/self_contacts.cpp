@@ -122,6 +122,11 @@ SelfContacts::SelfContacts(const Model& model)
   }
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
+  for (const auto& [a, b] : segments_)
+    nodes_.insert(nodes_.end(), { a, b });
+  std::sort(nodes_.begin(), nodes_.end());
+  nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
+  skin_ = kSkinRadii * largest_radius_;
 }
 
 void SelfContacts::remember(const State& state)
@@ -130,12 +135,20 @@ void SelfContacts::remember(const State& state)
     start_ = state.position;
 }
 
-bool SelfContacts::resolve(const Model& model, State& state)
+bool SelfContacts::candidatesHold(const NodeArray& x) const
 {
-  if (segments_.empty())
+  if (found_at_.cols() != x.cols())
     return false;
-  NodeArray& x = state.position;
-  NodeArray& v = state.velocity;
+  // Two links come closer by at most twice the farthest any of their nodes has moved.
+  const double limit = 0.25 * skin_ * skin_;
+  for (const int node : nodes_)
+    if ((x.col(node) - found_at_.col(node)).squaredNorm() > limit)
+      return false;
+  return true;
+}
+
+void SelfContacts::findCandidates(const NodeArray& x)
+{
   double longest = 0.0;
   for (std::size_t s = 0; s < segments_.size(); ++s)
   {
@@ -144,27 +157,49 @@ bool SelfContacts::resolve(const Model& model, State& state)
     half_[s] = 0.5 * (x.col(a) - x.col(b)).norm();
     longest = std::max(longest, 2.0 * half_[s]);
   }
-  // The pairs that touch, or nearly (within their radii again, as the passes move them): cells wide
-  // enough for the longest link and twice the largest radii.
-  const double reach = 2.0 * largest_radius_;
+  // Cells wide enough for the longest link, twice the largest radii and the skin.
+  const double reach = 2.0 * largest_radius_ + skin_;
   grid_.build(x, segments_, longest + 2.0 * reach + 1e-9);
-  near_.clear();
+  candidates_.clear();
   grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
     if (a == c || a == d || b == c || b == d || (body_[s] == body_[t] && std::abs(a - c) <= kSkippedLinks))
       return;
+    const double within = 2.0 * (radius_[s] + radius_[t]) + skin_;
     // Bounding balls first: most pairs in neighbouring cells are farther apart than that.
-    const double bound = half_[s] + half_[t] + 2.0 * (radius_[s] + radius_[t]);
+    const double bound = half_[s] + half_[t] + within;
     if ((middle_.col(static_cast<Eigen::Index>(s)) - middle_.col(static_cast<Eigen::Index>(t))).squaredNorm() >
         bound * bound)
       return;
     const Vec3 xa = x.col(a), xc = x.col(c);
     const auto [p, q] = contactParameters(xa, x.col(b) - xa, xc, x.col(d) - xc);
+    if (((xa + p * (x.col(b) - xa)) - (xc + q * (x.col(d) - xc))).norm() < within)
+      candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
+  });
+  found_at_ = x;
+}
+
+bool SelfContacts::resolve(const Model& model, State& state)
+{
+  if (segments_.empty())
+    return false;
+  NodeArray& x = state.position;
+  NodeArray& v = state.velocity;
+  if (!candidatesHold(x))
+    findCandidates(x);
+  // The pairs that touch, or nearly (within their radii again, as the passes move them).
+  near_.clear();
+  for (const auto& [s, t] : candidates_)
+  {
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    const Vec3 xa = x.col(a), xc = x.col(c);
+    const auto [p, q] = contactParameters(xa, x.col(b) - xa, xc, x.col(d) - xc);
     const double gap = ((xa + p * (x.col(b) - xa)) - (xc + q * (x.col(d) - xc))).norm();
     if (gap < 2.0 * (radius_[s] + radius_[t]))
-      near_.push_back({ static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t), 0.0, 0.0 });
-  });
+      near_.push_back({ s, t, 0.0, 0.0 });
+  }
   bool touched = false;
   const Eigen::VectorXd& w = model.inverse_mass;
   // The contact of pair k at the current positions: the nearest points' parameters, the unit normal from

@@ -96,7 +96,17 @@ public:
   /// (a pile) needs more than one.
   static constexpr int kPasses = 4;
 
+  /// The candidate pairs (those that may touch) are found with a margin, the skin, of this many largest
+  /// radii, and kept until some node has moved half the skin (a Verlet list, as in molecular dynamics):
+  /// a pile at rest is searched once, not every sub-step.
+  static constexpr double kSkinRadii = 2.0;
+
 private:
+  /// True if no node of a colliding link has moved half the skin since the candidates were found.
+  bool candidatesHold(const NodeArray& x) const;
+  /// The pairs within twice their radii and the skin, through the spatial hash.
+  void findCandidates(const NodeArray& x);
+
   std::vector<std::pair<int, int>> segments_;  ///< global node pairs of the colliding links
   std::vector<int> body_;                      ///< per segment: its body
   std::vector<double> radius_;                 ///< per segment: its nodes' mean contact radius [m]
@@ -104,9 +114,13 @@ private:
   bool any_friction_ = false;
   NodeArray start_;                            ///< positions at the sub-step's start, if any friction [m]
   double largest_radius_ = 0.0;                ///< [m]
-  NodeArray middle_;                           ///< per segment: its midpoint this sub-step [m]
-  std::vector<double> half_;                   ///< per segment: half its length this sub-step [m]
+  std::vector<int> nodes_;                     ///< the nodes of the colliding links, each once
+  double skin_ = 0.0;                          ///< [m]
+  NodeArray middle_;                           ///< per segment: its midpoint when candidates are found [m]
+  std::vector<double> half_;                   ///< per segment: half its length then [m]
   SegmentGrid grid_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates_;  ///< pairs that may touch
+  NodeArray found_at_;                         ///< positions when the candidates were found [m]
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
   {

@@ -40,10 +40,11 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
   std::size_t k = 1;  // the layout's segment from point k - 1 to point k holds node i
   for (int i = 0; i < rope.nodes; ++i)
   {
-    const double s = along.back() * i / (rope.nodes - 1);
+    const double fraction = static_cast<double>(i) / (rope.nodes - 1), s = along.back() * fraction;
     while (k + 1 < layout.size() && along[k] < s)
       ++k;
-    const double u = std::clamp((s - along[k - 1]) / (along[k] - along[k - 1]), 0.0, 1.0);
+    // A straight rope's nodes at exactly the fraction of the way (the rope's bits as without a path).
+    const double u = layout.size() == 2 ? fraction : std::clamp((s - along[k - 1]) / (along[k] - along[k - 1]), 0.0, 1.0);
     body.nodes.push_back(NodeDef{ layout[k - 1] + u * (layout[k] - layout[k - 1]), node_mass, Vec3::Zero(), false });
   }
   for (int index : rope.pinned)
