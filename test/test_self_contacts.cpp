@@ -175,13 +175,13 @@ TEST(SelfContacts, ACoiledRopeDroppedOnTheFloorNeverPassesThroughItself)
   }
 }
 
-
 // --- friction between links: a rope in a tilted groove ---------------------------------------------------
 
-/// Two straight rails (ropes pinned at every node, `rail_nodes` of them) 2 m long, tilted by theta about the y axis, downhill
-/// towards +x, and a free rope 0.3 m long lying in the groove between them: every rope 5 mm in radius,
-/// the rails 2 r sin(alpha) either side of the free rope's axis so that it touches them along normals at
-/// alpha = 45 degrees from the groove's upward normal. Coulomb friction `friction` on every rope.
+/// Two straight rails (ropes pinned at every node, `rail_nodes` of them) 2 m long, tilted by theta about
+/// the y axis, downhill towards +x, and a free rope 0.3 m long lying in the groove between them: every rope
+/// 5 mm in radius, the rails 2 r sin(alpha) either side of the free rope's axis so that it touches them
+/// along normals at alpha = 45 degrees from the groove's upward normal. Coulomb friction `friction` on
+/// every rope.
 SceneDef ropeInAGroove(double theta, double friction, int rail_nodes)
 {
   const double radius = 0.005, alpha = kPi / 4.0;
@@ -270,7 +270,6 @@ TEST(SelfContacts, ARopeInATiltedGrooveHoldsBelowTheWedgeFrictionAngleAndSlidesA
         EXPECT_NEAR(world.state().position(1, i), 0.0, 1e-3);
     }
 }
-
 
 // --- two ropes across each other ------------------------------------------------------------------------
 
@@ -375,7 +374,8 @@ std::vector<Vec3> overhandKnot(double link)
     for (int k = 0; k <= 400; ++k)
     {
       const double u = k / 400.0;  // the Bezier curve end -> end + down -> end + down + side turn
-      points.push_back((1 - u) * (1 - u) * end + 2 * u * (1 - u) * (end + down) + u * u * (end + down + side * turn * Vec3::UnitX()));
+      const Vec3 out = end + down + side * turn * Vec3::UnitX();
+      points.push_back((1 - u) * (1 - u) * end + 2 * u * (1 - u) * (end + down) + u * u * out);
     }
     for (int k = 1; k <= 200; ++k)
       points.push_back(points[400] + side * tail * k / 200.0 * Vec3::UnitX());
@@ -507,6 +507,24 @@ TEST(KnotDeterminant, IsThreeForTheOverhandKnotAndOneForUnknottedRopes)
   EXPECT_EQ(knotDeterminant(straight), 1);
 }
 
+/// The length [m] of rope in a knot of 1 cm links: from the first to the last link that passes within 3 cm
+/// of a link more than 5 places away (the tails, straight and apart, have none).
+double knotLength(const World& world)
+{
+  const NodeArray& x = world.state().position;
+  const int nodes = world.model().nodeCount();
+  int first = nodes, last = -1;
+  for (int i = 0; i + 1 < nodes; ++i)
+    for (int j = 0; j + 1 < nodes; ++j)
+      if (std::abs(i - j) > 5 && segmentDistance(x.col(i), x.col(i + 1), x.col(j), x.col(j + 1)) < 0.03)
+      {
+        first = std::min(first, i);
+        last = std::max(last, i);
+        break;
+      }
+  return (last - first + 1) * 0.01;
+}
+
 /// The overhand knot as a rope of radius 5 mm and 1 cm links (xpbd, no gravity), its two ends anchored
 /// and pulled apart along its tails, each 0.15 m at 0.1 m/s, then held.
 SceneDef knotScene(double friction)
@@ -547,22 +565,7 @@ TEST(SelfContacts, AnOverhandKnotPulledTightStaysAKnot)
     const Vec3 start = world.state().position.col(0), end = world.state().position.col(nodes - 1);
     world.followPath(0, [=](double t) { return std::optional<Vec3>(start + Vec3::UnitX() * 0.1 * std::min(t, 1.5)); });
     world.followPath(1, [=](double t) { return std::optional<Vec3>(end - Vec3::UnitX() * 0.1 * std::min(t, 1.5)); });
-    // The length of rope in the knot: from the first to the last link that passes within 3 cm of a link
-    // more than 5 places away (the tails, straight and apart, have none).
-    const auto knotLength = [&] {
-      const NodeArray& x = world.state().position;
-      int first = nodes, last = -1;
-      for (int i = 0; i + 1 < nodes; ++i)
-        for (int j = 0; j + 1 < nodes; ++j)
-          if (std::abs(i - j) > 5 && segmentDistance(x.col(i), x.col(i + 1), x.col(j), x.col(j + 1)) < 0.03)
-          {
-            first = std::min(first, i);
-            last = std::max(last, i);
-            break;
-          }
-      return (last - first + 1) * 0.01;
-    };
-    const double loose = knotLength();
+    const double loose = knotLength(world);
     double closest = 1e300;
     for (int n = 0; n < 150; ++n)
     {
@@ -574,7 +577,7 @@ TEST(SelfContacts, AnOverhandKnotPulledTightStaysAKnot)
     std::vector<Vec3> x;
     for (int i = 0; i < nodes; ++i)
       x.push_back(world.state().position.col(i));
-    const double tight = knotLength();
+    const double tight = knotLength(world);
     RecordProperty(friction > 0.0 ? "knot_closest_with_friction" : "knot_closest_without", std::to_string(closest));
     RecordProperty(friction > 0.0 ? "knot_length_with_friction" : "knot_length_without",
                    std::to_string(loose) + " -> " + std::to_string(tight));
@@ -592,20 +595,7 @@ TEST(SelfContacts, TheKnotSceneTightensUnderItsOwnWeightAndStaysAKnot)
 {
   World world = buildWorld(loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/knot.yaml"));
   const int nodes = world.model().nodeCount();
-  const auto knotLength = [&] {
-    const NodeArray& x = world.state().position;
-    int first = nodes, last = -1;
-    for (int i = 0; i + 1 < nodes; ++i)
-      for (int j = 0; j + 1 < nodes; ++j)
-        if (std::abs(i - j) > 5 && segmentDistance(x.col(i), x.col(i + 1), x.col(j), x.col(j + 1)) < 0.03)
-        {
-          first = std::min(first, i);
-          last = std::max(last, i);
-          break;
-        }
-    return (last - first + 1) * 0.01;
-  };
-  const double loose = knotLength();
+  const double loose = knotLength(world);
   double closest = 1e300;
   for (int n = 0; n < 180; ++n)
   {
@@ -620,7 +610,7 @@ TEST(SelfContacts, TheKnotSceneTightensUnderItsOwnWeightAndStaysAKnot)
     const Vec3 p = world.state().position.col(i);
     xz.push_back(Vec3(p.x(), p.z(), p.y()));
   }
-  const double tight = knotLength();
+  const double tight = knotLength(world);
   RecordProperty("knot_scene_length", std::to_string(loose) + " -> " + std::to_string(tight));
   RecordProperty("knot_scene_closest", std::to_string(closest));
   EXPECT_EQ(knotDeterminant(xz), 3);

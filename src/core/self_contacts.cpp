@@ -235,10 +235,11 @@ bool SelfContacts::resolve(const Model& model, State& state)
     y.col(segments_[t].first) -= k.kc * unit;
     y.col(segments_[t].second) -= k.kd * unit;
   };
-  const auto relativeVelocity = [&](std::size_t s, std::size_t t, const Contact& k) {
+  // The difference of y (positions or velocities) between the two nearest points.
+  const auto between = [&](std::size_t s, std::size_t t, const Contact& k, const NodeArray& y) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
-    return Vec3((1.0 - k.p) * v.col(a) + k.p * v.col(b) - (1.0 - k.q) * v.col(c) - k.q * v.col(d));
+    return Vec3((1.0 - k.p) * y.col(a) + k.p * y.col(b) - (1.0 - k.q) * y.col(c) - k.q * y.col(d));
   };
   // Projected Gauss-Seidel on each pair's accumulated push and speed change (Catto's accumulated
   // impulses): a pass may take back part of what an earlier one gave, never more. A push at a point
@@ -253,7 +254,7 @@ bool SelfContacts::resolve(const Model& model, State& state)
         continue;
       const double push = std::max(-pair.push, radius_[pair.s] + radius_[pair.t] - k.distance);
       // Only links that touch stop approaching; others give back what they took.
-      const double stop = pair.push + push > 0.0 ? std::max(-pair.stop, -relativeVelocity(pair.s, pair.t, k).dot(k.n))
+      const double stop = pair.push + push > 0.0 ? std::max(-pair.stop, -between(pair.s, pair.t, k, v).dot(k.n))
                                                  : -pair.stop;
       if (push != 0.0)
         part(pair.s, pair.t, k, x, push * k.n);
@@ -276,27 +277,18 @@ bool SelfContacts::resolve(const Model& model, State& state)
       const double friction = 0.5 * (friction_[pair.s] + friction_[pair.t]);
       if (!(friction > 0.0) || !(pair.push > 0.0 || pair.stop > 0.0) || !contact(pair.s, pair.t, k))
         continue;
-      const auto [a, b] = segments_[pair.s];
-      const auto [c, d] = segments_[pair.t];
-      const Vec3 moved = (1.0 - k.p) * (x.col(a) - start_.col(a)) + k.p * (x.col(b) - start_.col(b)) -
-                         (1.0 - k.q) * (x.col(c) - start_.col(c)) - k.q * (x.col(d) - start_.col(d));
-      const Vec3 slid = moved - moved.dot(k.n) * k.n;
-      const double slid_length = slid.norm();
-      if (slid_length > 0.0)
-      {
-        const double cancelled = std::min(slid_length, friction * pair.push);
-        part(pair.s, pair.t, k, x, -(cancelled / slid_length) * slid);
-        pair.push -= cancelled / friction;
-      }
-      const Vec3 relative = relativeVelocity(pair.s, pair.t, k);
-      const Vec3 tangential = relative - relative.dot(k.n) * k.n;
-      const double tangential_speed = tangential.norm();
-      if (tangential_speed > 0.0)
-      {
-        const double slowed = std::min(tangential_speed, friction * pair.stop);
-        part(pair.s, pair.t, k, v, -(slowed / tangential_speed) * tangential);
-        pair.stop -= slowed / friction;
-      }
+      // Cancels the tangential part of `relative` (a motion of y at the contact) up to friction * budget.
+      const auto resist = [&](const Vec3& relative, double& budget, NodeArray& y) {
+        const Vec3 tangential = relative - relative.dot(k.n) * k.n;
+        const double length = tangential.norm();
+        if (!(length > 0.0))
+          return;
+        const double taken = std::min(length, friction * budget);
+        part(pair.s, pair.t, k, y, -(taken / length) * tangential);
+        budget -= taken / friction;
+      };
+      resist(between(pair.s, pair.t, k, x) - between(pair.s, pair.t, k, start_), pair.push, x);
+      resist(between(pair.s, pair.t, k, v), pair.stop, v);
     }
   return touched;
 }

@@ -44,7 +44,8 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
     while (k + 1 < layout.size() && along[k] < s)
       ++k;
     // A straight rope's nodes at exactly the fraction of the way (the rope's bits as without a path).
-    const double u = layout.size() == 2 ? fraction : std::clamp((s - along[k - 1]) / (along[k] - along[k - 1]), 0.0, 1.0);
+    const double u =
+        layout.size() == 2 ? fraction : std::clamp((s - along[k - 1]) / (along[k] - along[k - 1]), 0.0, 1.0);
     body.nodes.push_back(NodeDef{ layout[k - 1] + u * (layout[k] - layout[k - 1]), node_mass, Vec3::Zero(), false });
   }
   for (int index : rope.pinned)

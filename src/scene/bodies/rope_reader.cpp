@@ -1,4 +1,5 @@
-// `type: rope` (spring-string-tutorial.txt): a straight chain of equal-mass nodes from `from` to `to`.
+// `type: rope` (spring-string-tutorial.txt): a chain of equal-mass nodes, straight from `from` to `to`
+// or along a `path`.
 #include "generated_body_keys.h"
 #include "soft_body_sim/core/bodies/rope.h"
 

@@ -1,5 +1,5 @@
-// A rope or string (spring-string-tutorial.txt): a straight chain of equal-mass nodes joined by damped
-// springs, optionally stiffened against bending by springs to second neighbours.
+// A rope or string (spring-string-tutorial.txt): a chain of equal-mass nodes, straight or laid along a
+// path, joined by damped springs, optionally stiffened against bending by springs to second neighbours.
 #pragma once
 
 #include <string>
