@@ -13,12 +13,15 @@
 // BM_CoiledRope/<plain|self_collision>/<nodes>: a rope laid to and fro, settled on the floor, without and
 // with self-collision (self_contacts.h), 1000 to 100,000 nodes; BM_CoiledRopeFalling the same while it
 // falls and lands (its links moving past each other: the candidate pairs found again more often).
+// BM_ClothOnSphere/<plain|self_collision>: a 64 x 64 cloth draping over a sphere, without and with
+// self-collision (its nodes as balls).
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
 #include <cmath>
 
 #include <benchmark/benchmark.h>
 
+#include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/forces.h"
 #include "large_cloth.h"
@@ -342,6 +345,51 @@ void BM_CoiledRopeFalling(benchmark::State& bench, bool self_collision)
   bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
 }
 
+/// A 64 x 64 cloth, 1.26 m square (2 cm spacing, 8 mm thick), dropped from 0.3 m onto a sphere of 0.25 m
+/// on the floor, so that it drapes and folds onto itself; each step of its first second, again and again.
+/// With or without self-collision (its nodes as balls, self_contacts.h). xpbd at 1/60 s, 8 sub-steps.
+void BM_ClothOnSphere(benchmark::State& bench, bool self_collision)
+{
+  ClothDef cloth;
+  cloth.nx = 64;
+  cloth.ny = 64;
+  cloth.corners.top_left = Vec3(-0.63, -0.63, 0.8);
+  cloth.corners.top_right = Vec3(0.63, -0.63, 0.8);
+  cloth.corners.bottom_left = Vec3(-0.63, 0.63, 0.8);
+  cloth.mass = 0.5;
+  cloth.structural = { 1000.0, 0.05 };
+  cloth.shear = { 500.0, 0.05 };
+  cloth.thickness = 0.008;
+  cloth.self_collision = self_collision;
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  scene.bodies.push_back(buildCloth("cloth", cloth));
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  Sphere sphere;
+  sphere.at.name = "ball";
+  sphere.at.position = Vec3(0.0, 0.0, 0.25);
+  sphere.at.friction = 0.5;
+  sphere.radius = 0.25;
+  scene.colliders.spheres.push_back(sphere);
+  World world = buildWorld(scene);
+  int steps = 0;
+  for (auto _ : bench)
+  {
+    if (steps == 60)
+    {
+      bench.PauseTiming();
+      world = buildWorld(scene);
+      steps = 0;
+      bench.ResumeTiming();
+    }
+    world.step();
+    ++steps;
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
+}
+
 /// Node counts from 100 to 100,000, two per decade.
 void clothSizes(benchmark::internal::Benchmark* bench)
 {
@@ -370,6 +418,8 @@ BENCHMARK_CAPTURE(BM_CoiledRope, plain, false)->Arg(1000)->Arg(10000)->Arg(10000
 BENCHMARK_CAPTURE(BM_CoiledRope, self_collision, true)->Arg(1000)->Arg(10000)->Arg(100000);
 BENCHMARK_CAPTURE(BM_CoiledRopeFalling, plain, false)->Arg(1000)->Arg(10000);
 BENCHMARK_CAPTURE(BM_CoiledRopeFalling, self_collision, true)->Arg(1000)->Arg(10000);
+BENCHMARK_CAPTURE(BM_ClothOnSphere, plain, false);
+BENCHMARK_CAPTURE(BM_ClothOnSphere, self_collision, true);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
 

@@ -1133,6 +1133,24 @@ TEST(SceneLoader, RopeSelfCollisionAndFrictionAreReadAndNeedARadius)
 // A rope laid along a path: an L of two 1 m legs, 5 nodes at equal arc lengths of 0.5 m, the middle one
 // at the corner; its links at rest as laid. Errors: from/to with path, fewer than 2 points, a repeated
 // point (no length between them), each at its key.
+// A cloth's self_collision needs a thickness from 0.36 to 0.5 times its node spacing (here 0.5 m / 5 =
+// 0.1 m); self_friction needs self_collision. Both read into the body.
+TEST(SceneLoader, ClothSelfCollisionNeedsAThicknessThatKeepsItsNodesFromSlippingThrough)
+{
+  const std::string cloth = "bodies: [{name: c, type: cloth, nx: 6, ny: 6, top_left: [0, 0, 1], top_right: [0.5, 0, 1], "
+                            "bottom_left: [0, 0.5, 1], mass: 1, structural: {stiffness: 100}, shear: {stiffness: 50}, ";
+  const World world = buildWorld(
+      parseScene(cloth + "thickness: 0.04, self_collision: true, self_friction: 0.2}]\n", "c.yaml"));
+  EXPECT_TRUE(world.model().bodies[0].self_collision);
+  EXPECT_EQ(world.model().bodies[0].self_friction, 0.2);
+  expectSceneError(cloth + "thickness: 0.02, self_collision: true}]\n", "bad.yaml:1: bodies[0].thickness",
+                   { "from 0.36 to 0.5 times the node spacing", "slips between four others" });
+  expectSceneError(cloth + "thickness: 0.06, self_collision: true}]\n", "bad.yaml:1: bodies[0].thickness",
+                   { "neighbours overlap at rest" });
+  expectSceneError(cloth + "thickness: 0.04, self_friction: 0.2}]\n", "bad.yaml:1: bodies[0].self_friction",
+                   { "needs self_collision: true" });
+}
+
 TEST(SceneLoader, RopePathLaysTheNodesAtEqualArcLengths)
 {
   const std::string rope = "bodies: [{name: r, type: rope, nodes: 5, mass: 1, stiffness: 1, ";

@@ -3,6 +3,7 @@
 // links at least its diameter apart (brute-force distances), where without self-collision it passes
 // through itself.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <optional>
@@ -13,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/self_contacts.h"
 #include "soft_body_sim/scene/scene_loader.h"
@@ -616,6 +618,107 @@ TEST(SelfContacts, TheKnotSceneTightensUnderItsOwnWeightAndStaysAKnot)
   EXPECT_EQ(knotDeterminant(xz), 3);
   EXPECT_GE(closest, 0.9 * 0.01);
   EXPECT_LT(tight, 0.6 * loose);
+}
+
+// --- a cloth folded onto itself -----------------------------------------------------------------------------
+
+/// A cloth of 21 x 11 nodes, 0.5 m x 0.25 m (2.5 cm spacing), 1 cm thick, lying flat on the floor (friction
+/// 0.5); its two right corners are anchors that carry its right half over the fold line x = 0.25 m in a
+/// half circle in 1.5 s and lay it onto the left half, 2 thicknesses up, then hold. xpbd, 8 sub-steps.
+SceneDef foldedCloth(bool self_collision)
+{
+  const double thickness = 0.01;
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  ClothDef cloth;
+  cloth.nx = 21;
+  cloth.ny = 11;
+  cloth.corners.top_left = Vec3(0.0, 0.0, thickness);
+  cloth.corners.top_right = Vec3(0.5, 0.0, thickness);
+  cloth.corners.bottom_left = Vec3(0.0, 0.25, thickness);
+  cloth.mass = 0.1;
+  cloth.structural = { 1000.0, 0.05 };
+  cloth.shear = { 500.0, 0.05 };
+  cloth.thickness = thickness;
+  cloth.self_collision = self_collision;
+  cloth.self_friction = 0.3;
+  BodyDef body = buildCloth("cloth", cloth);
+  body.self_collision = self_collision;  // the builder refuses none: off is off
+  body.anchors = { AnchorDef("top_right", 20), AnchorDef("bottom_right", 230) };
+  scene.bodies.push_back(body);
+  return scene;
+}
+
+/// Where a right corner that starts at `start` is at time t (foldedCloth).
+std::optional<Vec3> folded(const Vec3& start, double t)
+{
+  const double angle = kPi * std::min(t, 1.5) / 1.5, thickness = 0.01;
+  return Vec3(0.25 + 0.24 * std::cos(angle), start.y(), thickness + 0.24 * std::sin(angle) + 2.0 * thickness * angle / kPi);
+}
+
+/// The least height [m] of a node of the cloth's right half (columns 11 to 20) above the triangles of its
+/// left half (columns 0 to 9, two per square) under it, over the nodes that lie over the left half; 1e300
+/// if none does. Negative once a node has crossed the lower layer.
+double heightAboveLowerLayer(const NodeArray& x)
+{
+  const auto node = [](int i, int j) { return j * 21 + i; };
+  double least = 1e300;
+  for (int i = 11; i < 21; ++i)
+    for (int j = 0; j < 11; ++j)
+    {
+      const Vec3 p = x.col(node(i, j));
+      for (int a = 0; a < 9; ++a)
+        for (int b = 0; b < 10; ++b)
+          for (const auto& corners : { std::array<int, 3>{ node(a, b), node(a + 1, b), node(a + 1, b + 1) },
+                                       std::array<int, 3>{ node(a, b), node(a + 1, b + 1), node(a, b + 1) } })
+          {
+            const Vec3 p0 = x.col(corners[0]), p1 = x.col(corners[1]), p2 = x.col(corners[2]);
+            // Barycentric coordinates of p's projection on the xy plane.
+            const double area = (p1.x() - p0.x()) * (p2.y() - p0.y()) - (p2.x() - p0.x()) * (p1.y() - p0.y());
+            if (std::abs(area) < 1e-12)
+              continue;
+            const double u = ((p.x() - p0.x()) * (p2.y() - p0.y()) - (p2.x() - p0.x()) * (p.y() - p0.y())) / area;
+            const double v = ((p1.x() - p0.x()) * (p.y() - p0.y()) - (p.x() - p0.x()) * (p1.y() - p0.y())) / area;
+            if (u < 0.0 || v < 0.0 || u + v > 1.0)
+              continue;
+            least = std::min(least, p.z() - (p0.z() + u * (p1.z() - p0.z()) + v * (p2.z() - p0.z())));
+          }
+    }
+  return least;
+}
+
+// Folded in half, the cloth's upper layer never crosses the lower one: every node of the folded half
+// that lies over the lower half stays above its triangles at every step, by at least 0.8 thicknesses
+// (nodes are balls of the thickness t; an upper ball nested in the hollow between four lower ones at
+// spacing 2.5 t sits sqrt(4 - 3.125) t = 0.935 t above their plane; observed 0.92 t). Without
+// self-collision the upper layer sinks into the lower one.
+TEST(SelfContacts, AClothFoldedOntoItselfKeepsItsLayersApart)
+{
+  for (const bool self_collision : { true, false })
+  {
+    SCOPED_TRACE(self_collision ? "self_collision" : "without");
+    World world = buildWorld(foldedCloth(self_collision));
+    const Vec3 top_right = world.state().position.col(20), bottom_right = world.state().position.col(230);
+    world.followPath(0, [=](double t) { return folded(top_right, t); });
+    world.followPath(1, [=](double t) { return folded(bottom_right, t); });
+    double least = 1e300;
+    for (int n = 0; n < 150; ++n)
+    {
+      world.step();
+      ASSERT_TRUE(world.takeDivergenceEvents().empty());
+      least = std::min(least, heightAboveLowerLayer(world.state().position));
+    }
+    RecordProperty(self_collision ? "least_height_with" : "least_height_without", std::to_string(least));
+    for (int j = 0; j < 11; ++j)  // folded: the right half lies over the left
+      for (int i = 11; i < 21; ++i)
+        EXPECT_LT(world.state().position(0, j * 21 + i), 0.27) << "node " << i << ", " << j;
+    if (self_collision)
+      EXPECT_GE(least, 0.8 * 0.01);
+    else
+      EXPECT_LT(least, 0.5 * 0.01);
+  }
 }
 
 }  // namespace

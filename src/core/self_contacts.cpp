@@ -103,23 +103,39 @@ void SegmentGrid::build(const NodeArray& x, const std::vector<std::pair<int, int
     sorted_[cursor_[slot_of_[s]]++] = static_cast<std::uint32_t>(s);
 }
 
-SelfContacts::SelfContacts(const Model& model)
+SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
 {
   if (model.contact_radius.size() != model.nodeCount())
     return;  // a model made without radii (World gives it zeros): points, which do not collide
-  for (const auto& [a, b] : model.contact_segments)
-  {
-    const std::size_t body = model.bodyOf(a);
+  std::vector<Vec3> first_at_rest;
+  const auto add = [&](int a, int b, std::size_t body) {
     const double radius = 0.5 * (model.contact_radius[a] + model.contact_radius[b]);
     if (!model.bodies[body].self_collision || !(radius > 0.0))
-      continue;
+      return;
     segments_.emplace_back(a, b);
     body_.push_back(static_cast<int>(body));
     radius_.push_back(radius);
     friction_.push_back(model.bodies[body].self_friction);
     any_friction_ = any_friction_ || model.bodies[body].self_friction > 0.0;
     largest_radius_ = std::max(largest_radius_, radius);
+    first_at_rest.push_back(rest.col(a));
+  };
+  std::vector<bool> has_links(model.bodies.size(), false);
+  for (const auto& [a, b] : model.contact_segments)
+  {
+    const std::size_t body = model.bodyOf(a);
+    has_links[body] = true;
+    add(a, b, body);
   }
+  // A body without links (a cloth) collides by its nodes, each a ball of its contact radius: a segment
+  // from the node to itself.
+  for (std::size_t body = 0; body < model.bodies.size(); ++body)
+    if (!has_links[body])
+      for (int i = model.bodies[body].first; i < model.bodies[body].first + model.bodies[body].count; ++i)
+        add(i, i, body);
+  rest_.resize(3, static_cast<Eigen::Index>(segments_.size()));
+  for (std::size_t k = 0; k < first_at_rest.size(); ++k)
+    rest_.col(static_cast<Eigen::Index>(k)) = first_at_rest[k];
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
   for (const auto& [a, b] : segments_)
@@ -164,8 +180,19 @@ void SelfContacts::findCandidates(const NodeArray& x)
   grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
-    if (a == c || a == d || b == c || b == d || (body_[s] == body_[t] && std::abs(a - c) <= kSkippedLinks))
+    if (a == c || a == d || b == c || b == d)
       return;
+    if (body_[s] == body_[t])
+    {
+      // Neighbours along one rope touch at their joints; a cloth's nodes within twice their contact
+      // distance at rest (its direct and diagonal neighbours) are held apart by its springs, and come
+      // that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute Physics).
+      const bool links = a != b && c != d;
+      if (links ? std::abs(a - c) <= kSkippedLinks
+                : (rest_.col(static_cast<Eigen::Index>(s)) - rest_.col(static_cast<Eigen::Index>(t))).norm() <
+                      2.0 * (radius_[s] + radius_[t]))
+        return;
+    }
     const double within = 2.0 * (radius_[s] + radius_[t]) + skin_;
     // Bounding balls first: most pairs in neighbouring cells are farther apart than that.
     const double bound = half_[s] + half_[t] + within;

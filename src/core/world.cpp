@@ -19,7 +19,7 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
   , anchors_(model_.anchors.size())
   , integrators_(integrator, model_.bodies.size())
   , contacts_(model_)
-  , self_contacts_(model_)
+  , self_contacts_(model_, state_.position)
   , material_(model_)
   , guard_(state_, model_.bodies.size())
 {

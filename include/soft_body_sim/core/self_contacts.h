@@ -1,6 +1,7 @@
-// The self-contact stage of a step: the links of bodies that ask for it (`self_collision`, ropes) keep
-// apart by their radii, within a body and between such bodies, so that a rope can lie on itself and coil
-// instead of passing through itself. A scene in which no body asks has no pass here and pays nothing.
+// The self-contact stage of a step: the links of bodies that ask for it (`self_collision`; a rope's links,
+// a cloth's nodes as balls) keep apart by their radii, within a body and between such bodies, so that a
+// rope can lie on itself, coil and hold a knot, and a folded cloth's layers stay apart. A scene in which
+// no body asks has no pass here and pays nothing.
 #pragma once
 
 #include <cstdint>
@@ -68,11 +69,13 @@ void SegmentGrid::forEachNearPair(Visit visit) const
   }
 }
 
-/// Segment-against-segment contact of the bodies with `self_collision` (BodyRange).
+/// Segment-against-segment contact of the bodies with `self_collision` (BodyRange); a body without links
+/// (a cloth) gives each node as a segment from the node to itself.
 class SelfContacts
 {
 public:
-  explicit SelfContacts(const Model& model);
+  /// `rest`: the nodes' positions [m] at rest (the scene's start), which tell a cloth's neighbours apart.
+  SelfContacts(const Model& model, const NodeArray& rest);
 
   /// True if no body asks for self-collision: resolve() does nothing.
   bool empty() const { return segments_.empty(); }
@@ -110,6 +113,7 @@ private:
   std::vector<std::pair<int, int>> segments_;  ///< global node pairs of the colliding links
   std::vector<int> body_;                      ///< per segment: its body
   std::vector<double> radius_;                 ///< per segment: its nodes' mean contact radius [m]
+  NodeArray rest_;                             ///< per segment: its first node at rest [m]
   std::vector<double> friction_;               ///< per segment: its body's self_friction [-]
   bool any_friction_ = false;
   NodeArray start_;                            ///< positions at the sub-step's start, if any friction [m]

@@ -1,6 +1,8 @@
 #include "soft_body_sim/core/bodies/cloth.h"
 
+#include <algorithm>
 #include <stdexcept>
+#include <string>
 
 #include "soft_body_sim/core/bodies/rope.h"
 
@@ -87,10 +89,23 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   if (cloth.bending)
     requireSprings(what, "bending", *cloth.bending);
   requireDefinition(cloth.thickness >= 0.0, what, { "thickness" }, "thickness must be >= 0");
+  if (cloth.self_collision)
+  {
+    const double spacing = std::min((cloth.corners.top_right - cloth.corners.top_left).norm() / (cloth.nx - 1),
+                                    (cloth.corners.bottom_left - cloth.corners.top_left).norm() / (cloth.ny - 1));
+    // A node of radius r passes between four others of radius r at spacing d when d / sqrt(2) >= 2 r.
+    requireDefinition(cloth.thickness >= 0.36 * spacing && cloth.thickness < 0.5 * spacing, what, { "thickness" },
+                      "self_collision needs a thickness from 0.36 to 0.5 times the node spacing (" +
+                          std::to_string(spacing) + " m): thinner, a node slips between four others; thicker, "
+                          "neighbours overlap at rest");
+  }
+  requireDefinition(cloth.self_friction >= 0.0, what, { "self_friction" }, "self_friction must be >= 0");
   BodyDef body;
   body.name = name;
   body.type = "cloth";
   body.contact_radius = cloth.thickness;
+  body.self_collision = cloth.self_collision;
+  body.self_friction = cloth.self_friction;
   const int nx = cloth.nx;
   const int ny = cloth.ny;
   addSpringGrid(body, cloth.corners, nx, ny, cloth.mass, cloth.structural, cloth.shear);

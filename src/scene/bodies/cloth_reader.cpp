@@ -6,7 +6,8 @@ namespace soft_body_sim::scene_yaml
 BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass",
-                                              "structural", "shear", "bending", "pinned", "thickness" }));
+                                              "structural", "shear", "bending", "pinned", "thickness",
+                                              "self_collision", "self_friction" }));
   ClothDef cloth;
   cloth.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 2);
   const Field ny = requiredKey(ctx, field, "ny");
@@ -23,6 +24,14 @@ BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& 
     cloth.pinned = readPinned(ctx, *value, cloth.nx * cloth.ny, cloth.nx, cloth.ny);
   if (const std::optional<Field> value = optionalKey(field, "thickness"))
     cloth.thickness = readNumber(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "self_collision"))
+    cloth.self_collision = readBool(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "self_friction"))
+  {
+    cloth.self_friction = readNonNegative(ctx, *value);
+    if (!cloth.self_collision)
+      ctx.fail(*value, "needs self_collision: true: nodes that do not touch have no friction");
+  }
   return buildBody(ctx, field, cloth, buildCloth);
 }
 

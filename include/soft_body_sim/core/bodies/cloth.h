@@ -56,6 +56,12 @@ struct ClothDef
   std::optional<SpringParameters> bending;               ///< springs to second neighbours; none by default
   std::vector<int> pinned;                               ///< pinned node indices; negative counts from the end
   double thickness = 0.0;                                ///< [m] >= 0: contact radius of its nodes
+  /// Its nodes keep apart by their thickness from each other and from other self-colliding bodies
+  /// (self_contacts.h): a folded cloth's layers stay apart. Needs 0.36 <= thickness / spacing < 0.5 (the
+  /// spacing between neighbouring nodes): thinner, a node slips between four others; thicker, neighbours
+  /// overlap at rest.
+  bool self_collision = false;
+  double self_friction = 0.0;  ///< Coulomb coefficient [-] between touching nodes, >= 0
 };
 
 /// Appends to `body` a grid of columns x rows nodes of equal mass (mass / (columns rows) [kg]) spanning
