@@ -322,27 +322,33 @@ void BM_CoiledRope(benchmark::State& bench, bool self_collision)
   bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
 }
 
-/// The same rope while it falls and lands: the first 0.5 s after its release, again and again (the
-/// world rebuilt outside the timing), so that the links keep moving past each other.
-void BM_CoiledRopeFalling(benchmark::State& bench, bool self_collision)
+/// Steps a world built from `scene` again and again, rebuilding it (outside the timing) every `steps`
+/// steps: the cost of a scene's first moments, while its bodies fall and land.
+void stepFirstMoments(benchmark::State& bench, const SceneDef& scene, int steps)
 {
-  const SceneDef scene = coiledRope(static_cast<int>(bench.range(0)), self_collision);
   World world = buildWorld(scene);
-  int steps = 0;
+  int done = 0;
   for (auto _ : bench)
   {
-    if (steps == 30)
+    if (done == steps)
     {
       bench.PauseTiming();
       world = buildWorld(scene);
-      steps = 0;
+      done = 0;
       bench.ResumeTiming();
     }
     world.step();
-    ++steps;
+    ++done;
     benchmark::DoNotOptimize(world.state().position.data());
   }
   bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
+}
+
+/// The same rope while it falls and lands: the first 0.5 s after its release, again and again, so that the
+/// links keep moving past each other.
+void BM_CoiledRopeFalling(benchmark::State& bench, bool self_collision)
+{
+  stepFirstMoments(bench, coiledRope(static_cast<int>(bench.range(0)), self_collision), 30);
 }
 
 /// A 64 x 64 cloth, 1.26 m square (2 cm spacing, 8 mm thick), dropped from 0.3 m onto a sphere of 0.25 m
@@ -372,22 +378,7 @@ void BM_ClothOnSphere(benchmark::State& bench, bool self_collision)
   sphere.at.friction = 0.5;
   sphere.radius = 0.25;
   scene.colliders.spheres.push_back(sphere);
-  World world = buildWorld(scene);
-  int steps = 0;
-  for (auto _ : bench)
-  {
-    if (steps == 60)
-    {
-      bench.PauseTiming();
-      world = buildWorld(scene);
-      steps = 0;
-      bench.ResumeTiming();
-    }
-    world.step();
-    ++steps;
-    benchmark::DoNotOptimize(world.state().position.data());
-  }
-  bench.SetItemsProcessed(bench.iterations() * world.model().nodeCount() * world.settings().substeps);
+  stepFirstMoments(bench, scene, 60);
 }
 
 /// Node counts from 100 to 100,000, two per decade.

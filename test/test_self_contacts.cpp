@@ -27,6 +27,18 @@ namespace
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kGravity = 9.81;  // [m/s^2], PhysicsDef's default
 
+/// An empty scene stepped by xpbd at 1/60 s with 8 sub-steps and 2 iterations, with a floor at z = 0 of
+/// Coulomb coefficient `floor_friction` (none if negative).
+SceneDef xpbdScene(double floor_friction)
+{
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  if (floor_friction >= 0.0)
+    scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, floor_friction });
+  return scene;
+}
+
 /// The distance [m] between segments p0-p1 and q0-q1: the distance from the point p(u) = p0 + u (p1 - p0)
 /// to q's segment (its projection clamped to the segment, exact) is convex in u (the distance to a
 /// convex set along a line), so a golden-section search over u in [0, 1] finds its least value; 60
@@ -114,9 +126,7 @@ SceneDef coil(bool self_collision)
   const int nodes = 121;
   const double radius = 0.005, coil_radius = 0.1, link = 0.025;
   const double turn = 2.0 * kPi * coil_radius, pitch = 0.02;
-  SceneDef scene;
-  scene.physics.integrator = IntegratorType::Xpbd;
-  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  SceneDef scene = xpbdScene(0.5);
   RopeDef rope;
   rope.nodes = nodes;
   rope.mass = 0.15;
@@ -135,7 +145,6 @@ SceneDef coil(bool self_collision)
     spring.rest_length.reset();
   body.self_collision = self_collision;
   scene.bodies.push_back(body);
-  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
   return scene;
 }
 
@@ -189,9 +198,7 @@ SceneDef ropeInAGroove(double theta, double friction, int rail_nodes)
   const double radius = 0.005, alpha = kPi / 4.0;
   const Vec3 down(std::cos(theta), 0.0, -std::sin(theta)), up(std::sin(theta), 0.0, std::cos(theta));
   const Vec3 side = Vec3::UnitY() * 2.0 * radius * std::sin(alpha);
-  SceneDef scene;
-  scene.physics.integrator = IntegratorType::Xpbd;
-  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  SceneDef scene = xpbdScene(-1.0);
   for (const double sign : { -1.0, 1.0 })
   {
     RopeDef rail;
@@ -282,10 +289,7 @@ TEST(SelfContacts, ARopeInATiltedGrooveHoldsBelowTheWedgeFrictionAngleAndSlidesA
 SceneDef crossedRopes(double friction)
 {
   const double radius = 0.005;
-  SceneDef scene;
-  scene.physics.integrator = IntegratorType::Xpbd;
-  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
-  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.2 });
+  SceneDef scene = xpbdScene(0.2);
   RopeDef lower;
   lower.nodes = 101;
   lower.from = Vec3(0.0, -0.5, radius);
@@ -531,9 +535,7 @@ double knotLength(const World& world)
 /// and pulled apart along its tails, each 0.15 m at 0.1 m/s, then held.
 SceneDef knotScene(double friction)
 {
-  SceneDef scene;
-  scene.physics.integrator = IntegratorType::Xpbd;
-  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
+  SceneDef scene = xpbdScene(-1.0);
   scene.physics.gravity = Vec3::Zero();
   RopeDef rope;
   const std::vector<Vec3> shape = overhandKnot(0.01);
@@ -628,10 +630,7 @@ TEST(SelfContacts, TheKnotSceneTightensUnderItsOwnWeightAndStaysAKnot)
 SceneDef foldedCloth(bool self_collision)
 {
   const double thickness = 0.01;
-  SceneDef scene;
-  scene.physics.integrator = IntegratorType::Xpbd;
-  scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
-  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  SceneDef scene = xpbdScene(0.5);
   ClothDef cloth;
   cloth.nx = 21;
   cloth.ny = 11;

@@ -173,9 +173,9 @@ void SelfContacts::findCandidates(const NodeArray& x)
     half_[s] = 0.5 * (x.col(a) - x.col(b)).norm();
     longest = std::max(longest, 2.0 * half_[s]);
   }
-  // Cells wide enough for the longest link, twice the largest radii and the skin.
-  const double reach = 2.0 * largest_radius_ + skin_;
-  grid_.build(x, segments_, longest + 2.0 * reach + 1e-9);
+  // A candidate pair's links come within twice their radii and the skin (see below), so their midpoints
+  // within the longest link and that: the cells' width.
+  grid_.build(x, segments_, longest + 4.0 * largest_radius_ + skin_ + 1e-9);
   candidates_.clear();
   grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
     const auto [a, b] = segments_[s];
