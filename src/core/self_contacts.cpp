@@ -62,6 +62,17 @@ std::pair<double, double> contactParameters(const Vec3& p0, const Vec3& d1, cons
   return { s, t };
 }
 
+/// The vector [m] from the contact point of `to`'s segment to that of `from`'s (contactParameters), and
+/// their parameters p (along `from`) and q (along `to`).
+Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::pair<int, int>& to, double& p,
+                double& q)
+{
+  const Vec3 xa = x.col(from.first), xc = x.col(to.first);
+  const Vec3 along_from = x.col(from.second) - xa, along_to = x.col(to.second) - xc;
+  std::tie(p, q) = contactParameters(xa, along_from, xc, along_to);
+  return (xa + p * along_from) - (xc + q * along_to);
+}
+
 /// A cell coordinate, kept far from the integer limits (a node at 1e300 m is a diverged one the guard
 /// deals with; here it only has to stay a valid index).
 std::int32_t cellCoordinate(double position, double cell)
@@ -107,7 +118,6 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
 {
   if (model.contact_radius.size() != model.nodeCount())
     return;  // a model made without radii (World gives it zeros): points, which do not collide
-  std::vector<Vec3> first_at_rest;
   const auto add = [&](int a, int b, std::size_t body) {
     const double radius = 0.5 * (model.contact_radius[a] + model.contact_radius[b]);
     if (!model.bodies[body].self_collision || !(radius > 0.0))
@@ -118,7 +128,6 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
     friction_.push_back(model.bodies[body].self_friction);
     any_friction_ = any_friction_ || model.bodies[body].self_friction > 0.0;
     largest_radius_ = std::max(largest_radius_, radius);
-    first_at_rest.push_back(rest.col(a));
   };
   std::vector<bool> has_links(model.bodies.size(), false);
   for (const auto& [a, b] : model.contact_segments)
@@ -134,8 +143,8 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
       for (int i = model.bodies[body].first; i < model.bodies[body].first + model.bodies[body].count; ++i)
         add(i, i, body);
   rest_.resize(3, static_cast<Eigen::Index>(segments_.size()));
-  for (std::size_t k = 0; k < first_at_rest.size(); ++k)
-    rest_.col(static_cast<Eigen::Index>(k)) = first_at_rest[k];
+  for (std::size_t k = 0; k < segments_.size(); ++k)
+    rest_.col(static_cast<Eigen::Index>(k)) = rest.col(segments_[k].first);
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
   for (const auto& [a, b] : segments_)
@@ -199,9 +208,8 @@ void SelfContacts::findCandidates(const NodeArray& x)
     if ((middle_.col(static_cast<Eigen::Index>(s)) - middle_.col(static_cast<Eigen::Index>(t))).squaredNorm() >
         bound * bound)
       return;
-    const Vec3 xa = x.col(a), xc = x.col(c);
-    const auto [p, q] = contactParameters(xa, x.col(b) - xa, xc, x.col(d) - xc);
-    if (((xa + p * (x.col(b) - xa)) - (xc + q * (x.col(d) - xc))).norm() < within)
+    double p, q;
+    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < within)
       candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
   });
   found_at_ = x;
@@ -219,12 +227,8 @@ bool SelfContacts::resolve(const Model& model, State& state)
   near_.clear();
   for (const auto& [s, t] : candidates_)
   {
-    const auto [a, b] = segments_[s];
-    const auto [c, d] = segments_[t];
-    const Vec3 xa = x.col(a), xc = x.col(c);
-    const auto [p, q] = contactParameters(xa, x.col(b) - xa, xc, x.col(d) - xc);
-    const double gap = ((xa + p * (x.col(b) - xa)) - (xc + q * (x.col(d) - xc))).norm();
-    if (gap < 2.0 * (radius_[s] + radius_[t]))
+    double p, q;
+    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
       near_.push_back({ s, t, 0.0, 0.0 });
   }
   bool touched = false;
@@ -239,9 +243,7 @@ bool SelfContacts::resolve(const Model& model, State& state)
   const auto contact = [&](std::size_t s, std::size_t t, Contact& k) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
-    const Vec3 xa = x.col(a), xb = x.col(b), xc = x.col(c), xd = x.col(d);
-    std::tie(k.p, k.q) = contactParameters(xa, xb - xa, xc, xd - xc);
-    const Vec3 between = (xa + k.p * (xb - xa)) - (xc + k.q * (xd - xc));
+    const Vec3 between = contactGap(x, segments_[s], segments_[t], k.p, k.q);
     k.distance = between.norm();
     if (!(k.distance > 1e-12))
       return false;  // crossing exactly: no direction to part them in (the next sub-step has one)
