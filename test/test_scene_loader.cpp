@@ -1130,9 +1130,6 @@ TEST(SceneLoader, RopeSelfCollisionAndFrictionAreReadAndNeedARadius)
                    "bad.yaml:1: bodies[0].self_friction", { ">= 0" });
 }
 
-// A rope laid along a path: an L of two 1 m legs, 5 nodes at equal arc lengths of 0.5 m, the middle one
-// at the corner; its links at rest as laid. Errors: from/to with path, fewer than 2 points, a repeated
-// point (no length between them), each at its key.
 // A cloth's self_collision needs a thickness from 0.36 to 0.5 times its node spacing (here 0.5 m / 5 =
 // 0.1 m); self_friction needs self_collision. Both read into the body.
 TEST(SceneLoader, ClothSelfCollisionNeedsAThicknessThatKeepsItsNodesFromSlippingThrough)
@@ -1151,6 +1148,31 @@ TEST(SceneLoader, ClothSelfCollisionNeedsAThicknessThatKeepsItsNodesFromSlipping
                    { "needs self_collision: true" });
 }
 
+// A jelly's self_collision (its nodes out of its springs) needs a thickness of at most a quarter of the
+// distance from a cell's corner to its diagonal: here 0.1 m x 0.05 m cells, 0.1 * 0.05 / sqrt(0.0125) =
+// 0.0447 m, so at most 0.0112 m.
+TEST(SceneLoader, JellySelfCollisionNeedsAThicknessClearOfItsCellsDiagonals)
+{
+  const std::string jelly = "bodies: [{name: j, type: jelly, nx: 4, ny: 4, top_left: [0, 0, 1], top_right: [0.4, 0, 1], "
+                            "bottom_left: [0, 0, 0.8], mass: 1, edges: {stiffness: 100}, diagonals: {stiffness: 50}, "
+                            "pressure: 100, ";
+  const World world = buildWorld(
+      parseScene(jelly + "thickness: 0.011, self_collision: true, self_friction: 0.3}]\n", "j.yaml"));
+  EXPECT_TRUE(world.model().bodies[0].self_collision);
+  EXPECT_TRUE(world.model().bodies[0].springs_collide);
+  EXPECT_EQ(world.model().bodies[0].self_friction, 0.3);
+  EXPECT_FALSE(buildWorld(parseScene(jelly + "thickness: 0.011}]\n", "j.yaml")).model().bodies[0].self_collision);
+  expectSceneError(jelly + "thickness: 0.0113, self_collision: true}]\n", "bad.yaml:1: bodies[0].thickness",
+                   { "a quarter of the distance from a cell's corner to its diagonal (0.0447", "0.0113" });
+  expectSceneError(jelly + "self_collision: true}]\n", "bad.yaml:1: bodies[0].self_collision",
+                   { "needs thickness > 0" });
+  expectSceneError(jelly + "thickness: 0.01, self_friction: 0.2}]\n", "bad.yaml:1: bodies[0].self_friction",
+                   { "needs self_collision: true" });
+}
+
+// A rope laid along a path: an L of two 1 m legs, 5 nodes at equal arc lengths of 0.5 m, the middle one
+// at the corner; its links at rest as laid. Errors: from/to with path, fewer than 2 points, a repeated
+// point (no length between them), each at its key.
 TEST(SceneLoader, RopePathLaysTheNodesAtEqualArcLengths)
 {
   const std::string rope = "bodies: [{name: r, type: rope, nodes: 5, mass: 1, stiffness: 1, ";

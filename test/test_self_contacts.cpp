@@ -642,9 +642,8 @@ SceneDef foldedCloth(bool self_collision)
   cloth.shear = { 500.0, 0.05 };
   cloth.thickness = thickness;
   cloth.self_collision = self_collision;
-  cloth.self_friction = 0.3;
+  cloth.self_friction = self_collision ? 0.3 : 0.0;
   BodyDef body = buildCloth("cloth", cloth);
-  body.self_collision = self_collision;  // the builder refuses none: off is off
   body.anchors = { AnchorDef("top_right", 20), AnchorDef("bottom_right", 230) };
   scene.bodies.push_back(body);
   return scene;

@@ -34,6 +34,16 @@ int resolveNodeIndex(long long index, int node_count)
   return static_cast<int>(resolved);
 }
 
+void requireSelfContact(const std::string& what, bool self_collision, double self_friction, double contact_radius,
+                        const std::string& radius_key)
+{
+  requireDefinition(!self_collision || contact_radius > 0.0, what, { "self_collision", radius_key },
+                    "self_collision needs " + radius_key + " > 0: parts without thickness cannot keep apart");
+  requireDefinition(self_friction >= 0.0, what, { "self_friction" }, "self_friction must be >= 0");
+  requireDefinition(self_friction == 0.0 || self_collision, what, { "self_friction" },
+                    "self_friction needs self_collision: true: parts that do not touch have no friction");
+}
+
 double maxContactRadius(const SceneDef& scene)
 {
   double radius = 0.0;
@@ -110,9 +120,9 @@ World buildWorld(const SceneDef& scene)
     }
     if (body.controller)
       controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });
-    if (!(body.self_friction >= 0.0))
-      throw std::invalid_argument("body '" + body.name + "': self_friction must be >= 0");
-    model.bodies.push_back({ body.name, first, count, body.self_collision, body.self_friction });
+    requireSelfContact("body '" + body.name + "'", body.self_collision, body.self_friction, body.contact_radius,
+                       "contact_radius");
+    model.bodies.push_back({ body.name, first, count, body.self_collision, body.self_friction, body.springs_collide });
     first += count;
   }
   StepSettings step = scene.physics.step;

@@ -136,12 +136,21 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
     has_links[body] = true;
     add(a, b, body);
   }
-  // A body without links (a cloth) collides by its nodes, each a ball of its contact radius: a segment
-  // from the node to itself.
+  // A body without links (a cloth, a jelly) collides by its nodes, each a ball of its contact radius: a
+  // segment from the node to itself.
   for (std::size_t body = 0; body < model.bodies.size(); ++body)
     if (!has_links[body])
       for (int i = model.bodies[body].first; i < model.bodies[body].first + model.bodies[body].count; ++i)
         add(i, i, body);
+  // A jelly's springs too, which its nodes stay out of.
+  for (const Spring& spring : model.springs)
+  {
+    const std::size_t body = model.bodyOf(spring.a);
+    if (model.bodies[body].springs_collide)
+      add(spring.a, spring.b, body);
+  }
+  for (const BodyRange& body : model.bodies)
+    springs_collide_.push_back(body.springs_collide);
   rest_.resize(3, static_cast<Eigen::Index>(segments_.size()));
   for (std::size_t k = 0; k < segments_.size(); ++k)
     rest_.col(static_cast<Eigen::Index>(k)) = rest.col(segments_[k].first);
@@ -193,14 +202,23 @@ void SelfContacts::findCandidates(const NodeArray& x)
       return;
     if (body_[s] == body_[t])
     {
-      // Neighbours along one rope touch at their joints; a cloth's nodes within twice their contact
-      // distance at rest (its direct and diagonal neighbours) are held apart by its springs, and come
-      // that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute Physics).
-      const bool links = a != b && c != d;
-      if (links ? std::abs(a - c) <= kSkippedLinks
-                : (rest_.col(static_cast<Eigen::Index>(s)) - rest_.col(static_cast<Eigen::Index>(t))).norm() <
-                      2.0 * (radius_[s] + radius_[t]))
+      // Neighbours along one rope touch at their joints; a jelly's springs cross each other at rest (a
+      // cell's diagonals) and only its nodes stay out of them; a cloth's (or jelly's) nodes within twice
+      // their contact distance at rest (its direct and diagonal neighbours) are held apart by its springs,
+      // and come that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute
+      // Physics).
+      const bool ball_s = a == b, ball_t = c == d;
+      if (!ball_s && !ball_t)
+      {
+        if (springs_collide_[static_cast<std::size_t>(body_[s])] || std::abs(a - c) <= kSkippedLinks)
+          return;
+      }
+      else if (ball_s && ball_t &&
+               (rest_.col(static_cast<Eigen::Index>(s)) - rest_.col(static_cast<Eigen::Index>(t))).norm() <
+                   2.0 * (radius_[s] + radius_[t]))
+      {
         return;
+      }
     }
     const double within = 2.0 * (radius_[s] + radius_[t]) + skin_;
     // Bounding balls first: most pairs in neighbouring cells are farther apart than that.

@@ -61,6 +61,7 @@ struct BodyRange
   int count = 0;
   bool self_collision = false;  ///< its links keep apart by their radii (self_contacts.h)
   double self_friction = 0.0;   ///< Coulomb coefficient [-] where they touch (self_contacts.h)
+  bool springs_collide = false; ///< its springs too keep its own nodes out (a jelly; self_contacts.h)
 };
 
 /// A named node of a body that the caller moves kinematically (its node is pinned).

@@ -82,13 +82,22 @@ struct BodyDef
   /// Pairs of node indices within the body whose segment collides as a whole (a rope's links), not
   /// only at its ends.
   std::vector<std::pair<int, int>> contact_segments;
-  /// Its contact segments keep apart from each other and from those of other such bodies
-  /// (self_contacts.h); needs contact_radius > 0.
+  /// Its contact segments (or, without any, its nodes as balls) keep apart from each other and from
+  /// those of other such bodies (self_contacts.h); needs contact_radius > 0.
   bool self_collision = false;
   /// Coulomb coefficient [-] >= 0 between its contact segments and those they touch (self_collision;
   /// two bodies touching each other use the mean of theirs).
   double self_friction = 0.0;
+  /// With self_collision: its springs too are capsules of its contact radius, which its own nodes stay
+  /// out of (a jelly: no node crosses a spring).
+  bool springs_collide = false;
 };
+
+/// The checks of a body type's self-contact keys (rope, cloth, jelly), for its builder: self_friction
+/// >= 0 and only with self_collision, and self_collision only with a contact radius > 0 (the key
+/// `radius_key`). Throws DefinitionError naming the keys.
+void requireSelfContact(const std::string& what, bool self_collision, double self_friction, double contact_radius,
+                        const std::string& radius_key);
 
 struct PhysicsDef
 {

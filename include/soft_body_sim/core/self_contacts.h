@@ -1,7 +1,8 @@
 // The self-contact stage of a step: the links of bodies that ask for it (`self_collision`; a rope's links,
-// a cloth's nodes as balls) keep apart by their radii, within a body and between such bodies, so that a
-// rope can lie on itself, coil and hold a knot, and a folded cloth's layers stay apart. A scene in which
-// no body asks has no pass here and pays nothing.
+// a cloth's nodes as balls, a jelly's nodes as balls and its springs as capsules) keep apart by their
+// radii, within a body and between such bodies, so that a rope can lie on itself, coil and hold a knot, a
+// folded cloth's layers stay apart and no node of a squeezed jelly crosses a spring. A scene in which no
+// body asks has no pass here and pays nothing.
 #pragma once
 
 #include <cstdint>
@@ -70,7 +71,8 @@ void SegmentGrid::forEachNearPair(Visit visit) const
 }
 
 /// Segment-against-segment contact of the bodies with `self_collision` (BodyRange); a body without links
-/// (a cloth) gives each node as a segment from the node to itself.
+/// (a cloth, a jelly) gives each node as a segment from the node to itself, and one with springs_collide
+/// (a jelly) its springs as well, against which only its nodes collide.
 class SelfContacts
 {
 public:
@@ -112,6 +114,7 @@ private:
 
   std::vector<std::pair<int, int>> segments_;  ///< global node pairs of the colliding links
   std::vector<int> body_;                      ///< per segment: its body
+  std::vector<bool> springs_collide_;          ///< per body: BodyRange::springs_collide
   std::vector<double> radius_;                 ///< per segment: its nodes' mean contact radius [m]
   NodeArray rest_;                             ///< per segment: its first node at rest [m]
   std::vector<double> friction_;               ///< per segment: its body's self_friction [-]

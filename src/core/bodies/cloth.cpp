@@ -99,7 +99,7 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
                           std::to_string(spacing) + " m): thinner, a node slips between four others; thicker, "
                           "neighbours overlap at rest");
   }
-  requireDefinition(cloth.self_friction >= 0.0, what, { "self_friction" }, "self_friction must be >= 0");
+  requireSelfContact(what, cloth.self_collision, cloth.self_friction, cloth.thickness, "thickness");
   BodyDef body;
   body.name = name;
   body.type = "cloth";

@@ -1,5 +1,6 @@
 #include "soft_body_sim/core/bodies/jelly.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "soft_body_sim/core/bodies/cloth.h"
@@ -15,10 +16,27 @@ BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
   requireSprings(what, "diagonals", jelly.diagonals);
   requireDefinition(jelly.pressure > 0.0, what, { "pressure" }, "pressure must be > 0");
   requireDefinition(jelly.thickness >= 0.0, what, { "thickness" }, "thickness must be >= 0");
+  requireSelfContact(what, jelly.self_collision, jelly.self_friction, jelly.thickness, "thickness");
+  if (jelly.self_collision)
+  {
+    // A parallelogram cell of area A: each corner lies A / d from the diagonal d it is not on, the
+    // nearest of the springs it does not end on.
+    const Vec3 across = (jelly.corners.top_right - jelly.corners.top_left) / jelly.nx;
+    const Vec3 down = (jelly.corners.bottom_left - jelly.corners.top_left) / jelly.ny;
+    const double clearance =
+        across.cross(down).norm() / std::max((across + down).norm(), (across - down).norm());
+    requireDefinition(jelly.thickness <= 0.25 * clearance, what, { "thickness" },
+                      "self_collision needs a thickness of at most a quarter of the distance from a cell's "
+                      "corner to its diagonal (" + std::to_string(clearance) + " m): thicker, a node would "
+                      "touch the springs of its own cell at rest");
+  }
   BodyDef body;
   body.name = name;
   body.type = "jelly";
   body.contact_radius = jelly.thickness;
+  body.self_collision = jelly.self_collision;
+  body.self_friction = jelly.self_friction;
+  body.springs_collide = true;
   const int columns = jelly.nx + 1;
   addSpringGrid(body, jelly.corners, columns, jelly.ny + 1, jelly.mass, jelly.edges, jelly.diagonals);
   // One gas cell per square, its nodes right along the top edge, then down the left edge: counter-

@@ -19,6 +19,7 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
   requireDefinition(rope.bending_damping == 0.0 || rope.bending > 0.0, what, { "bending_damping" },
                     "bending_damping has no effect without bending > 0 (there are no bending springs to damp)");
   requireDefinition(rope.radius >= 0.0, what, { "radius" }, "radius must be >= 0");
+  requireSelfContact(what, rope.self_collision, rope.self_friction, rope.radius, "radius");
   if (rope.path.empty())
     requireDefinition((rope.to - rope.from).norm() > 0.0, what, { "to", "from" },
                       "to must differ from 'from'; a rope needs a length");
@@ -36,6 +37,8 @@ BodyDef buildRope(const std::string& name, const RopeDef& rope)
   body.name = name;
   body.type = "rope";
   body.contact_radius = rope.radius;
+  body.self_collision = rope.self_collision;
+  body.self_friction = rope.self_friction;
   const double node_mass = rope.mass / rope.nodes;
   std::size_t k = 1;  // the layout's segment from point k - 1 to point k holds node i
   for (int i = 0; i < rope.nodes; ++i)

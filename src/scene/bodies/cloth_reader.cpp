@@ -24,14 +24,7 @@ BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& 
     cloth.pinned = readPinned(ctx, *value, cloth.nx * cloth.ny, cloth.nx, cloth.ny);
   if (const std::optional<Field> value = optionalKey(field, "thickness"))
     cloth.thickness = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "self_collision"))
-    cloth.self_collision = readBool(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "self_friction"))
-  {
-    cloth.self_friction = readNonNegative(ctx, *value);
-    if (!cloth.self_collision)
-      ctx.fail(*value, "needs self_collision: true: nodes that do not touch have no friction");
-  }
+  readSelfContact(ctx, field, cloth);
   return buildBody(ctx, field, cloth, buildCloth);
 }
 

@@ -1,5 +1,5 @@
 // Keys shared by the readers of the generated mass-spring bodies (rope, cloth, jelly): node counts,
-// spring families, grid corners and pinned nodes. Private to those readers.
+// spring families, grid corners, pinned nodes and self-contact. Private to those readers.
 #pragma once
 
 #include <string>
@@ -40,6 +40,17 @@ inline SpringParameters readSpringParameters(const Context& ctx, const Field& fi
   if (const std::optional<Field> value = optionalKey(field, "damping"))
     spring.damping = readNumber(ctx, *value);
   return spring;
+}
+
+/// The optional keys self_collision and self_friction of `body` (default false and 0), as given: the
+/// builder checks them (requireSelfContact).
+template <typename Def>
+void readSelfContact(const Context& ctx, const Field& body, Def& def)
+{
+  if (const std::optional<Field> value = optionalKey(body, "self_collision"))
+    def.self_collision = readBool(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(body, "self_friction"))
+    def.self_friction = readNumber(ctx, *value);
 }
 
 /// The required keys top_left, top_right and bottom_left [m] of a grid body.

@@ -7,7 +7,8 @@ namespace soft_body_sim::scene_yaml
 BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass", "edges",
-                                              "diagonals", "pressure", "thickness" }));
+                                              "diagonals", "pressure", "thickness", "self_collision",
+                                              "self_friction" }));
   JellyDef jelly;
   jelly.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 1);
   const Field ny = requiredKey(ctx, field, "ny");
@@ -21,6 +22,7 @@ BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& 
   jelly.pressure = readNumber(ctx, requiredKey(ctx, field, "pressure"));
   if (const std::optional<Field> value = optionalKey(field, "thickness"))
     jelly.thickness = readNumber(ctx, *value);
+  readSelfContact(ctx, field, jelly);
   return buildBody(ctx, field, jelly, buildJelly);
 }
 

@@ -45,24 +45,8 @@ BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& s
     rope.pinned = readPinned(ctx, *value, rope.nodes);
   if (const std::optional<Field> value = optionalKey(field, "radius"))
     rope.radius = readNumber(ctx, *value);
-  bool self_collision = false;
-  if (const std::optional<Field> value = optionalKey(field, "self_collision"))
-  {
-    self_collision = readBool(ctx, *value);
-    if (self_collision && !(rope.radius > 0.0))
-      ctx.fail(*value, "needs radius > 0: links without thickness cannot keep apart");
-  }
-  double self_friction = 0.0;
-  if (const std::optional<Field> value = optionalKey(field, "self_friction"))
-  {
-    self_friction = readNonNegative(ctx, *value);
-    if (!self_collision)
-      ctx.fail(*value, "needs self_collision: true: links that do not touch have no friction");
-  }
-  BodyDef body = buildBody(ctx, field, rope, buildRope);
-  body.self_collision = self_collision;
-  body.self_friction = self_friction;
-  return body;
+  readSelfContact(ctx, field, rope);
+  return buildBody(ctx, field, rope, buildRope);
 }
 
 }  // namespace soft_body_sim::scene_yaml

@@ -7,7 +7,8 @@
 //     cross. Here each cell is a gas at Boyle's law, with an energy of its signed area that grows
 //     without bound as the cell is squeezed and, past that barrier, still pushes an inverted cell
 //     back (CellGas in forces.h); every integrator treats it (forces, implicit_euler's Jacobian, xpbd's
-//     area constraint).
+//     area constraint). The gas does not hold a jelly that a collider presses flat; with
+//     self_collision its nodes stay out of its springs (self_contacts.h).
 //  2. jitter at the walls: the seed reverses a node's velocity at every contact, so the weight of the
 //     structure drives the bottom nodes to vibrate. Plane contacts here remove the normal approach
 //     and do not bounce below a resting speed (collisions.h). A jelly's floor should have restitution
@@ -35,6 +36,13 @@ struct JellyDef
   SpringParameters diagonals{ 1000.0, 0.5 };                 ///< springs along both diagonals of each cell
   double pressure = 1000.0;                                  ///< each cell's rest gas pressure p0 [N/m], > 0
   double thickness = 0.0;                                    ///< [m] >= 0: contact radius of its nodes
+  /// Its nodes (balls of its thickness) stay out of its springs (capsules of its thickness), so that no
+  /// node crosses a spring and no cell turns inside out however hard it is squeezed, and keep apart from
+  /// other self-colliding bodies (self_contacts.h). Needs 0 < thickness <= a quarter of the distance from
+  /// a cell's corner to the diagonal it is not on: the nodes start two contact distances clear of every
+  /// spring.
+  bool self_collision = false;
+  double self_friction = 0.0;                                ///< Coulomb coefficient [-] where it touches, >= 0
 };
 
 /// The jelly as nodes, springs and pressure cells (type "jelly"). Each cell's corners run

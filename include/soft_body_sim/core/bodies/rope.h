@@ -25,6 +25,10 @@ struct RopeDef
   double bending_damping = 0.0;       ///< their dashpot [N s/m]
   std::vector<int> pinned;            ///< pinned node indices; negative counts from the end (-1 = last)
   double radius = 0.0;                ///< [m] >= 0: contact radius of its nodes (0 = points)
+  /// Its links keep apart by their radius from each other (but for neighbours along it,
+  /// SelfContacts::kSkippedLinks) and from other self-colliding bodies (self_contacts.h); needs radius > 0.
+  bool self_collision = false;
+  double self_friction = 0.0;         ///< Coulomb coefficient [-] between touching links, >= 0
 };
 
 /// The rope as nodes and springs (type "rope"); throws std::invalid_argument on a bad definition.
