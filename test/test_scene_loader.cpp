@@ -1110,24 +1110,55 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
 
 TEST(SceneLoader, RopeSelfCollisionAndFrictionAreReadAndNeedARadius)
 {
-  const std::string rope = "bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, "
+  // Two sub-steps: a 2 m fall (there is no floor) at 6.3 m/s moves 3.1 mm per sub-step, within the radius.
+  const std::string rope = "physics: {substeps: 2}\n"
+                           "bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, "
                            "stiffness: 1";
   const SceneDef scene = parseScene(rope + ", radius: 0.005, self_collision: true}]\n", "rope.yaml");
   ASSERT_EQ(scene.bodies.size(), 1u);
   EXPECT_TRUE(scene.bodies[0].self_collision);
   EXPECT_TRUE(buildWorld(scene).model().bodies[0].self_collision);
   EXPECT_FALSE(parseScene(rope + ", radius: 0.005}]\n", "rope.yaml").bodies[0].self_collision);
-  expectSceneError(rope + ", self_collision: true}]\n", "bad.yaml:1: bodies[0].self_collision",
+  expectSceneError(rope + ", self_collision: true}]\n", "bad.yaml:2: bodies[0].self_collision",
                    { "needs radius > 0" });
-  expectSceneError(rope + ", radius: 0.005, self_collision: sometimes}]\n", "bad.yaml:1: bodies[0].self_collision",
+  expectSceneError(rope + ", radius: 0.005, self_collision: sometimes}]\n", "bad.yaml:2: bodies[0].self_collision",
                    { "sometimes" });
   const SceneDef rough = parseScene(rope + ", radius: 0.005, self_collision: true, self_friction: 0.4}]\n", "r.yaml");
   EXPECT_EQ(buildWorld(rough).model().bodies[0].self_friction, 0.4);
   EXPECT_EQ(scene.bodies[0].self_friction, 0.0);
-  expectSceneError(rope + ", radius: 0.005, self_friction: 0.4}]\n", "bad.yaml:1: bodies[0].self_friction",
+  expectSceneError(rope + ", radius: 0.005, self_friction: 0.4}]\n", "bad.yaml:2: bodies[0].self_friction",
                    { "needs self_collision: true" });
   expectSceneError(rope + ", radius: 0.005, self_collision: true, self_friction: -0.1}]\n",
-                   "bad.yaml:1: bodies[0].self_friction", { ">= 0" });
+                   "bad.yaml:2: bodies[0].self_friction", { ">= 0" });
+}
+
+// The rule against passing through: a self-colliding rope's links move at most its radius per sub-step
+// at the speed of a fall from its highest free node onto the floor (2 m without one). A rope 1 m above
+// the floor falls at sqrt(2 g) = 4.43 m/s; at dt = 10 ms that is 44.3 mm per step, so a 5 mm rope needs
+// 9 sub-steps. Reported at physics.substeps, or at the rope's self_collision if the file does not set
+// them; `dt: auto` takes them itself; a rope pinned at every node (none free to fall) needs none.
+TEST(SceneLoader, SelfCollisionNeedsSubStepsWithinTheRadiusOfAFallOntoTheFloor)
+{
+  const std::string floor = "planes: [{point: [0, 0, 0], normal: [0, 0, 1]}]\n";
+  const std::string rope = "bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], "
+                           "mass: 1, stiffness: 1, radius: 0.005, self_collision: true}]\n";
+  EXPECT_NO_THROW(parseScene("physics: {dt: 0.01, substeps: 9}\n" + floor + rope, "r.yaml"));
+  expectSceneError("physics: {dt: 0.01, substeps: 8}\n" + floor + rope, "bad.yaml:1: physics.substeps",
+                   { "body 'r' (self_collision)", "a fall of 1 m", "4.43 m/s", "5.54 mm per sub-step",
+                     "needs substeps >= 9 at dt 0.01 s" });
+  expectSceneError("physics: {dt: 0.01}\n" + floor + rope, "bad.yaml:3: bodies[0].self_collision",
+                   { "needs substeps >= 9" });
+  // Without the floor, the rule assumes a fall of 2 m: 6.26 m/s, 13 sub-steps.
+  expectSceneError("physics: {dt: 0.01, substeps: 12}\n" + rope, "bad.yaml:1: physics.substeps",
+                   { "a fall of 2 m", "needs substeps >= 13" });
+  const SceneDef automatic = parseScene("physics: {dt: auto}\n" + floor + rope, "r.yaml");
+  const World world = buildWorld(automatic);
+  EXPECT_LE(std::sqrt(2.0 * 9.81 * 1.0) * world.settings().dt / world.settings().substeps, 0.005);
+  EXPECT_GT(std::sqrt(2.0 * 9.81 * 1.0) * world.settings().dt / (world.settings().substeps - 1), 0.005);
+  EXPECT_NO_THROW(parseScene("physics: {dt: 0.01, substeps: 8}\n" + floor +
+                             "bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [0, 0, 0.5], "
+                             "mass: 1, stiffness: 1, radius: 0.005, self_collision: true, pinned: [0, 1, 2]}]\n",
+                             "r.yaml"));
 }
 
 // A cloth's self_collision needs a thickness from 0.36 to 0.5 times its node spacing (here 0.5 m / 5 =

@@ -1,6 +1,8 @@
 #include "soft_body_sim/core/scene_def.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <stdexcept>
 #include <string>
 
@@ -50,6 +52,63 @@ double maxContactRadius(const SceneDef& scene)
   for (const BodyDef& body : scene.bodies)
     radius = std::max(radius, body.contact_radius);
   return radius;
+}
+
+std::optional<TunnellingRisk> tunnellingRisk(const SceneDef& scene, const StepSettings& step)
+{
+  const double g = scene.physics.gravity.norm();
+  const Vec3 up = g > 0.0 ? Vec3(-scene.physics.gravity / g) : Vec3::UnitZ();
+  const double h = step.dt / step.substeps;
+  for (std::size_t b = 0; b < scene.bodies.size(); ++b)
+  {
+    const BodyDef& body = scene.bodies[b];
+    if (!body.self_collision || !(body.contact_radius > 0.0))
+      continue;
+    std::vector<bool> held(body.nodes.size(), false);  // pinned or anchored: they do not fall
+    for (std::size_t k = 0; k < body.nodes.size(); ++k)
+      held[k] = body.nodes[k].pinned;
+    for (const AnchorDef& anchor : body.anchors)
+      held[static_cast<std::size_t>(resolveNodeIndex(anchor.node, static_cast<int>(body.nodes.size())))] = true;
+    double fall = 0.0, initial = 0.0;
+    for (std::size_t k = 0; k < body.nodes.size(); ++k)
+    {
+      const NodeDef& node = body.nodes[k];
+      initial = std::max(initial, node.velocity.norm());
+      if (held[k])
+        continue;
+      double below = kUnsupportedFall;  // down to the first plane under it that faces up
+      bool supported = false;
+      for (const Plane& plane : scene.colliders.planes)
+      {
+        const double facing = plane.normal.dot(up);
+        const double height = (node.position - plane.point).dot(plane.normal) / facing;
+        if (facing > 0.0 && height >= 0.0 && (!supported || height < below))
+        {
+          below = height;
+          supported = true;
+        }
+      }
+      fall = std::max(fall, below);
+    }
+    const double speed = std::sqrt(2.0 * g * fall) + initial;
+    if (speed * h <= body.contact_radius)
+      continue;
+    TunnellingRisk risk;
+    risk.body = b;
+    const double needed = std::ceil(speed * step.dt / body.contact_radius);
+    constexpr int kMost = 1000000;  // a bound for absurd scenes (a node 1e300 m up), not a count to use
+    risk.substeps = needed < kMost ? static_cast<int>(needed) : kMost;
+    char numbers[400];
+    std::snprintf(numbers, sizeof numbers,
+                  "a fall of %.3g m (its highest free node onto the first floor below, or %g m without one) and "
+                  "its initial speeds give %.3g m/s, %.3g mm per sub-step of %.3g ms, more than its contact radius "
+                  "%.3g mm: its parts could pass through each other; needs substeps >= %d at dt %g s",
+                  fall, kUnsupportedFall, speed, 1e3 * speed * h, 1e3 * h, 1e3 * body.contact_radius, risk.substeps,
+                  step.dt);
+    risk.why = "body '" + body.name + "' (self_collision): " + numbers;
+    return risk;
+  }
+  return std::nullopt;
 }
 
 World buildWorld(const SceneDef& scene)
@@ -127,7 +186,13 @@ World buildWorld(const SceneDef& scene)
   }
   StepSettings step = scene.physics.step;
   if (scene.physics.auto_dt)
+  {
     step = chooseStableStep(model, state, scene.physics.integrator, step.iterations);
+    // and the sub-steps that keep the rule against passing through
+    for (std::optional<TunnellingRisk> risk = tunnellingRisk(scene, step); risk && risk->substeps > step.substeps;
+         risk = tunnellingRisk(scene, step))
+      step.substeps = risk->substeps;
+  }
   World world(std::move(model), std::move(state), scene.physics.integrator, step, std::move(controllers));
   world.setGuard(scene.physics.guard);
   return world;

@@ -45,6 +45,11 @@ std::string SimNode::applySimConfig(const SimConfig& config)
     return why;
   const Vec3 gravity = RosConverter::gravityOf(config);
   const StepSettings settings = RosConverter::stepSettingsOf(config);
+  // The scene's rule against passing through, at the new step and gravity.
+  SceneDef tuned = scene_;
+  tuned.physics.gravity = gravity;
+  if (const std::optional<TunnellingRisk> risk = tunnellingRisk(tuned, settings))
+    return risk->why;
   // Only what changed is set: a new integrator object (or a new dt) restarts multistep histories.
   if (integrator != world_->integrator())
     world_->setIntegrator(integrator);

@@ -361,6 +361,15 @@ SceneDef readScene(const Context& ctx, const Field& root)
   }
   if (scene.bodies.empty())
     ctx.fail(bodies, "must not be empty; a scene needs at least one body");
+  // The rule against passing through, at the key that mends it (with `dt: auto`, buildWorld checks it).
+  if (!scene.physics.auto_dt)
+    if (const std::optional<TunnellingRisk> risk = tunnellingRisk(scene, scene.physics.step))
+    {
+      const std::optional<Field> physics = optionalKey(root, "physics");
+      const std::optional<Field> substeps = physics ? optionalKey(*physics, "substeps") : std::nullopt;
+      ctx.fail(substeps ? *substeps : firstPresent(requireList(ctx, bodies)[risk->body], { "self_collision" }),
+               risk->why);
+    }
   // Built once here, as wide as the thickest body needs: every world built from the scene (a reset too)
   // shares them.
   buildMeshFields(scene.colliders.meshes, maxContactRadius(scene));

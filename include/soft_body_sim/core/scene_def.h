@@ -103,7 +103,8 @@ struct PhysicsDef
 {
   IntegratorType integrator = IntegratorType::SemiImplicitEuler;
   StepSettings step;                        ///< dt [s], substeps, iterations
-  /// `dt: auto`: buildWorld replaces step.dt and step.substeps by chooseStableStep's (stability.h).
+  /// `dt: auto`: buildWorld replaces step.dt and step.substeps by chooseStableStep's (stability.h), with
+  /// more sub-steps where the rule against passing through needs them (tunnellingRisk).
   bool auto_dt = false;
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);     ///< [m/s^2]
   double drag = 0.0;                        ///< [1/s]
@@ -141,10 +142,29 @@ int resolveNodeIndex(long long index, int node_count);
 /// distance field must reach (buildMeshFields).
 double maxContactRadius(const SceneDef& scene);
 
+/// The rule against passing through (self_contacts.h), for the step `step`: each self-colliding body's
+/// parts move at most its contact radius r per sub-step h at the speed they can meet at,
+///   v = sqrt(2 |g| H) + the fastest of its nodes' initial speeds,
+/// H the fall from its highest free (not pinned or anchored) node down to the first plane below it that faces up
+/// (kUnsupportedFall if there is none). At that speed two parts come at most r closer in a sub-step, so
+/// neither gets past the middle of their contact distance 2 r unseen, and the contact pushes it back the
+/// way it came. A body that its anchors or a collider move faster is beyond the rule.
+struct TunnellingRisk
+{
+  std::size_t body = 0;  ///< index in SceneDef::bodies
+  int substeps = 1;      ///< the sub-steps at step.dt that keep the rule
+  std::string why;       ///< the message: the body, the fall, the speed, the sub-steps it needs
+};
+/// The fall [m] the rule assumes for a body with no plane below it.
+constexpr double kUnsupportedFall = 2.0;
+/// The first body that breaks the rule at `step`, if any.
+std::optional<TunnellingRisk> tunnellingRisk(const SceneDef& scene, const StepSettings& step);
+
 /// Flattens the bodies into one node array (body k's nodes follow body k-1's), pins anchored nodes,
 /// makes the controllers and returns the world. Expects a valid scene (the loader checks); throws
 /// std::invalid_argument on an index out of range, a bad collider (a zero plane normal), a zero cell
-/// normal, or a cell whose rest area is not positive.
+/// normal, or a cell whose rest area is not positive. With `dt: auto` it also takes the sub-steps that
+/// the rule against passing through needs (tunnellingRisk); a fixed step is the loader's to check.
 World buildWorld(const SceneDef& scene);
 
 }  // namespace soft_body_sim
