@@ -173,10 +173,16 @@ bool SelfContacts::candidatesHold(const NodeArray& x) const
 {
   if (found_at_.cols() != x.cols())
     return false;
-  // Two links come closer by at most twice the farthest any of their nodes has moved.
+  // Two links come closer by at most |d_i - c| + |d_j - c| for their nodes' displacements d_i, d_j since
+  // the candidates were found and any common c, since moving everything by c changes no distance. With c
+  // the mean displacement, a body that falls or is carried as a whole keeps its list.
+  Vec3 mean = Vec3::Zero();
+  for (const int node : nodes_)
+    mean += x.col(node) - found_at_.col(node);
+  mean /= static_cast<double>(nodes_.size());
   const double limit = 0.25 * skin_ * skin_;
   for (const int node : nodes_)
-    if ((x.col(node) - found_at_.col(node)).squaredNorm() > limit)
+    if ((x.col(node) - found_at_.col(node) - mean).squaredNorm() > limit)
       return false;
   return true;
 }
@@ -231,6 +237,7 @@ void SelfContacts::findCandidates(const NodeArray& x)
       candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
   });
   found_at_ = x;
+  ++searches_;
 }
 
 bool SelfContacts::resolve(const Model& model, State& state)

@@ -94,6 +94,9 @@ public:
   /// touched.
   bool resolve(const Model& model, State& state);
 
+  /// How many times the candidate pairs have been searched: once per Verlet list (kSkinRadii).
+  std::size_t searches() const { return searches_; }
+
   /// Two links of one body whose first nodes are this many places apart or fewer never collide: a rope
   /// bent back on itself within a few links touches itself at its joints already.
   static constexpr int kSkippedLinks = 2;
@@ -102,12 +105,14 @@ public:
   static constexpr int kPasses = 4;
 
   /// The candidate pairs (those that may touch) are found with a margin, the skin, of this many largest
-  /// radii, and kept until some node has moved half the skin (a Verlet list, as in molecular dynamics):
-  /// a pile at rest is searched once, not every sub-step.
+  /// radii, and kept until some node has moved half the skin relative to their mean motion (a Verlet
+  /// list, as in molecular dynamics): a pile at rest, or a cloth falling flat, is searched once, not
+  /// every sub-step.
   static constexpr double kSkinRadii = 2.0;
 
 private:
-  /// True if no node of a colliding link has moved half the skin since the candidates were found.
+  /// True if no node of a colliding link has moved half the skin, relative to their mean motion, since
+  /// the candidates were found.
   bool candidatesHold(const NodeArray& x) const;
   /// The pairs within twice their radii and the skin, through the spatial hash.
   void findCandidates(const NodeArray& x);
@@ -128,6 +133,7 @@ private:
   SegmentGrid grid_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates_;  ///< pairs that may touch
   NodeArray found_at_;                         ///< positions when the candidates were found [m]
+  std::size_t searches_ = 0;
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
   {

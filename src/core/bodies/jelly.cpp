@@ -27,8 +27,8 @@ BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
         across.cross(down).norm() / std::max((across + down).norm(), (across - down).norm());
     requireDefinition(jelly.thickness <= 0.25 * clearance, what, { "thickness" },
                       "self_collision needs a thickness of at most a quarter of the distance from a cell's "
-                      "corner to its diagonal (" + std::to_string(clearance) + " m): thicker, a node would "
-                      "touch the springs of its own cell at rest");
+                      "corner to its diagonal (" + std::to_string(clearance) + " m): thicker, its nodes start "
+                      "less than two contact distances from the springs of their cells");
   }
   BodyDef body;
   body.name = name;
