@@ -148,6 +148,50 @@ TEST(Simulate, CommandLineOverridesTheSceneAndCsvGoesToTheFile)
   EXPECT_NE(std::stod(table[3][3]), 2.0 + 0.25 * f / (5.0 * std::sqrt(2.0)));
 }
 
+TEST(Simulate, ForcesAndTensionsGoToTheirFilesAtTheRowsTimes)
+{
+  // A 0.5 kg mass hanging at rest from an anchored 0.1 kg node on a spring of 49.05 N/m, stretched
+  // 0.1 m by the mass's weight: the spring's tension is 0.5 g, the anchor carries both weights.
+  const std::string scene = writeScene("hanging.yaml", R"(
+frame_id: world
+physics: {integrator: semi_implicit_euler, dt: 0.01, gravity: [0, 0, -9.81]}
+bodies:
+  - name: weight
+    type: custom
+    nodes:
+      - {position: [0, 0, 0], mass: 0.1, pinned: true}
+      - {position: [0, 0, -1.1], mass: 0.5}
+    springs:
+      - {nodes: [0, 1], stiffness: 49.05, rest_length: 1.0}
+    anchors:
+      - {name: hook, node: 0}
+)");
+  const std::string forces = ::testing::TempDir() + "forces.csv";
+  const std::string tensions = ::testing::TempDir() + "tensions.csv";
+  const Outcome r = runWith({ "--scene", scene, "--duration", "0.1", "--every", "5", "--forces", forces,
+                              "--tensions", tensions });
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto read = [](const std::string& path) {
+    std::ifstream file(path);
+    return rows(std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>()));
+  };
+  const auto force_rows = read(forces);
+  ASSERT_EQ(force_rows.size(), 4u);  // header, t = 0, 0.05, 0.1
+  EXPECT_EQ(force_rows[0], (std::vector<std::string>{ "t", "body", "anchor", "fx", "fy", "fz", "tx", "ty", "tz" }));
+  EXPECT_EQ(force_rows[2][0], "0.050000000000000003");
+  EXPECT_EQ(force_rows[3][1], "weight");
+  EXPECT_EQ(force_rows[3][2], "hook");
+  EXPECT_NEAR(std::stod(force_rows[3][5]), -0.6 * 9.81, 1e-9);
+  for (int column : { 3, 4, 6, 7, 8 })
+    EXPECT_NEAR(std::stod(force_rows[3][column]), 0.0, 1e-12) << column;
+  const auto tension_rows = read(tensions);
+  ASSERT_EQ(tension_rows.size(), 4u);
+  EXPECT_EQ(tension_rows[0], (std::vector<std::string>{ "t", "body", "kind", "index", "a", "b", "tension" }));
+  EXPECT_EQ(tension_rows[3], (std::vector<std::string>{ "0.10000000000000001", "weight", "spring", "0", "0", "1",
+                                                        tension_rows[3][6] }));
+  EXPECT_NEAR(std::stod(tension_rows[3][6]), 0.5 * 9.81, 1e-9);
+}
+
 struct BadInput
 {
   const char* name;
@@ -189,6 +233,7 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInput{ "UnknownIntegrator", { "--scene", "SCENE", "--integrator", "euler" }, "unknown integrator 'euler' (valid: explicit_euler," },
                       BadInput{ "MissingSceneFile", { "--scene", "/nonexistent/scene.yaml" }, "/nonexistent/scene.yaml: cannot open" },
                       BadInput{ "UnwritableCsv", { "--scene", "SCENE", "--csv", "/nonexistent/out.csv" }, "--csv: cannot write" },
+                      BadInput{ "UnwritableForces", { "--scene", "SCENE", "--forces", "/nonexistent/f.csv" }, "--forces: cannot write" },
                       BadInput{ "GivenTwice", { "--scene", "SCENE", "--dt", "1", "--dt", "2" }, "--dt: given twice" }),
     [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
 

@@ -16,8 +16,7 @@ void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeAr
     double length;
     if (!springAxis(x, s.a, s.b, u, length))
       continue;
-    const double closing_speed = (v.col(s.a) - v.col(s.b)).dot(u);
-    const Vec3 f = (-s.stiffness * (length - s.rest_length) - s.damping * closing_speed) * u;
+    const Vec3 f = -springTension(s, u, length, v) * u;
     force.col(s.a) += f;
     force.col(s.b) -= f;
   }

@@ -56,4 +56,17 @@ const std::vector<std::string>& integratorNames()
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type) { return entry(type).make(); }
 
+void springLawTensions(const Model& model, const State& state, Eigen::VectorXd& tension)
+{
+  tension.setZero(static_cast<Eigen::Index>(model.springs.size() + model.constraints.size()));
+  for (std::size_t k = 0; k < model.springs.size(); ++k)
+  {
+    const Spring& s = model.springs[k];
+    Vec3 u;
+    double length;
+    if (springAxis(state.position, s.a, s.b, u, length))
+      tension[static_cast<Eigen::Index>(k)] = springTension(s, u, length, state.velocity);
+  }
+}
+
 }  // namespace soft_body_sim

@@ -41,6 +41,23 @@ void IntegratorGroups::step(const Model& model, State& state, double h, int iter
     group.integrator->stepWithContacts(group.model, state, h, iterations, contacts);
 }
 
+void IntegratorGroups::linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const
+{
+  if (groups_.empty())
+  {
+    integrator_->linkTensions(model, state, tension);
+    return;
+  }
+  tension.setZero(static_cast<Eigen::Index>(model.springs.size() + model.constraints.size()));
+  Eigen::VectorXd mine;
+  for (const Group& group : groups_)
+  {
+    group.integrator->linkTensions(group.model, state, mine);
+    for (std::size_t k = 0; k < group.links.size(); ++k)
+      tension[static_cast<Eigen::Index>(group.links[k])] = mine[static_cast<Eigen::Index>(k)];
+  }
+}
+
 void IntegratorGroups::invalidate()
 {
   integrator_->invalidate();
@@ -78,7 +95,7 @@ void IntegratorGroups::rebuild(const Model& model)
   for (const IntegratorType type : types)
   {
     const auto mine = [&](int node) { return node_type[static_cast<std::size_t>(node)] == type; };
-    Group group{ type, model, makeIntegrator(type) };
+    Group group{ type, model, makeIntegrator(type), {} };
     Model& m = group.model;
     for (int i = 0; i < m.nodeCount(); ++i)
       if (!mine(i))
@@ -86,11 +103,19 @@ void IntegratorGroups::rebuild(const Model& model)
     // The elements that touch a node of the group (the others belong to other groups); no colliders:
     // contact is the world's stage, not the group's.
     m.springs.clear();
-    std::copy_if(model.springs.begin(), model.springs.end(), std::back_inserter(m.springs),
-                 [&](const Spring& s) { return mine(s.a) || mine(s.b); });
     m.constraints.clear();
-    std::copy_if(model.constraints.begin(), model.constraints.end(), std::back_inserter(m.constraints),
-                 [&](const DistanceConstraint& c) { return mine(c.a) || mine(c.b); });
+    for (std::size_t k = 0; k < model.springs.size(); ++k)
+      if (mine(model.springs[k].a) || mine(model.springs[k].b))
+      {
+        m.springs.push_back(model.springs[k]);
+        group.links.push_back(k);
+      }
+    for (std::size_t k = 0; k < model.constraints.size(); ++k)
+      if (mine(model.constraints[k].a) || mine(model.constraints[k].b))
+      {
+        m.constraints.push_back(model.constraints[k]);
+        group.links.push_back(model.springs.size() + k);
+      }
     m.cells.clear();
     std::copy_if(model.cells.begin(), model.cells.end(), std::back_inserter(m.cells), [&](const PressureCell& c) {
       return std::any_of(std::begin(c.nodes), std::end(c.nodes), mine);

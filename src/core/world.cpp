@@ -261,6 +261,25 @@ bool World::detach(int anchor)
   return true;
 }
 
+Eigen::VectorXd World::linkTensions() const
+{
+  Eigen::VectorXd tension;
+  integrators_.linkTensions(model_, state_, tension);
+  return tension;
+}
+
+std::vector<Wrench> World::anchorWrenches() const
+{
+  std::vector<Wrench> wrenches;
+  if (model_.anchors.empty())
+    return wrenches;
+  NodeArray pull;
+  linkPulls(model_, state_.position, linkTensions(), pull);
+  for (const Anchor& anchor : model_.anchors)
+    wrenches.push_back(holdingWrench(model_, state_.position, pull, { anchor.node }, state_.position.col(anchor.node)));
+  return wrenches;
+}
+
 double World::energy() const { return kineticEnergy(model_, state_) + potentialEnergy(model_, state_); }
 
 }  // namespace soft_body_sim

@@ -24,7 +24,7 @@ struct UsageError : std::runtime_error
 
 const char* const kUsage =
     "usage: simulate --scene FILE [--duration S] [--integrator NAME] [--dt S] [--substeps N] "
-    "[--iterations N] [--every K] [--csv FILE]";
+    "[--iterations N] [--every K] [--csv FILE] [--forces FILE] [--tensions FILE]";
 
 struct Options
 {
@@ -37,6 +37,8 @@ struct Options
   std::optional<int> iterations;
   std::optional<long long> every;
   std::optional<std::string> csv;
+  std::optional<std::string> forces;    ///< anchors' wrenches
+  std::optional<std::string> tensions;  ///< links' tensions
 };
 
 double parseNumber(const std::string& option, const std::string& text)
@@ -81,7 +83,8 @@ Options parseOptions(const std::vector<std::string>& args)
   {
     const std::string& option = args[k];
     static const char* const kKnown[] = { "--scene", "--duration", "--integrator", "--dt",
-                                          "--substeps", "--iterations", "--every", "--csv" };
+                                          "--substeps", "--iterations", "--every", "--csv",
+                                          "--forces", "--tensions" };
     if (std::find(std::begin(kKnown), std::end(kKnown), option) == std::end(kKnown))
       throw UsageError("unknown option '" + option + "'; " + kUsage);
     if (k + 1 >= args.size())
@@ -119,6 +122,10 @@ Options parseOptions(const std::vector<std::string>& args)
     options.every = parsePositiveInteger("--every", values["--every"]);
   if (values.count("--csv"))
     options.csv = values["--csv"];
+  if (values.count("--forces"))
+    options.forces = values["--forces"];
+  if (values.count("--tensions"))
+    options.tensions = values["--tensions"];
   return options;
 }
 
@@ -158,6 +165,53 @@ void writeRows(std::ostream& csv, const World& world)
   }
 }
 
+/// Per anchor, the wrench its body exerts on it (World::anchorWrenches).
+void writeForces(std::ostream& csv, const World& world)
+{
+  const std::vector<Wrench> wrenches = world.anchorWrenches();
+  for (std::size_t k = 0; k < wrenches.size(); ++k)
+  {
+    const Anchor& anchor = world.model().anchors[k];
+    const Vec3& f = wrenches[k].force;
+    const Vec3& m = wrenches[k].torque;
+    csv << world.time() << ',' << anchor.body << ',' << anchor.name << ',' << f.x() << ',' << f.y() << ',' << f.z()
+        << ',' << m.x() << ',' << m.y() << ',' << m.z() << '\n';
+  }
+}
+
+/// Per spring and constraint, its tension (World::linkTensions), with its body, its place among the body's
+/// springs (constraints) and its ends' indices in the body. buildWorld adds each body's links in order.
+void writeTensions(std::ostream& csv, const World& world)
+{
+  const Model& model = world.model();
+  const Eigen::VectorXd tension = world.linkTensions();
+  std::vector<int> count(model.bodies.size());
+  const auto row = [&](const char* kind, int a, int b, double t) {
+    const std::size_t body = model.bodyOf(a);
+    const int first = model.bodies[body].first;
+    csv << world.time() << ',' << model.bodies[body].name << ',' << kind << ',' << count[body]++ << ','
+        << a - first << ',' << b - first << ',' << t << '\n';
+  };
+  for (std::size_t k = 0; k < model.springs.size(); ++k)
+    row("spring", model.springs[k].a, model.springs[k].b, tension[static_cast<Eigen::Index>(k)]);
+  std::fill(count.begin(), count.end(), 0);
+  for (std::size_t k = 0; k < model.constraints.size(); ++k)
+    row("constraint", model.constraints[k].a, model.constraints[k].b,
+        tension[static_cast<Eigen::Index>(model.springs.size() + k)]);
+}
+
+/// An output file named by `option`, or none.
+std::optional<std::ofstream> openOutput(const std::string& option, const std::optional<std::string>& path)
+{
+  if (!path)
+    return std::nullopt;
+  std::ofstream file(*path);
+  if (!file)
+    throw UsageError(option + ": cannot write '" + *path + "'");
+  file << std::setprecision(17);
+  return file;
+}
+
 void simulate(const Options& options, std::ostream& out, std::ostream& err)
 {
   SceneDef scene = loadSceneFile(options.scene);
@@ -165,13 +219,9 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
   World world = buildWorld(scene);
   const long long steps = std::llround(options.duration / world.settings().dt);
 
-  std::ofstream file;
-  if (options.csv)
-  {
-    file.open(*options.csv);
-    if (!file)
-      throw UsageError("--csv: cannot write '" + *options.csv + "'");
-  }
+  std::optional<std::ofstream> file = openOutput("--csv", options.csv);
+  std::optional<std::ofstream> forces = openOutput("--forces", options.forces);
+  std::optional<std::ofstream> tensions = openOutput("--tensions", options.tensions);
   if (scene.physics.auto_dt)
     err << "simulate: note: dt auto chose dt = " << world.settings().dt << " s in " << world.settings().substeps
         << " sub-step(s) for " << integratorName(world.integrator()) << '\n';
@@ -179,19 +229,30 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
   // so that bad input still gets its one line).
   for (const std::string& warning : stabilityWarnings(world.model(), world.state(), world.integrator(), world.settings()))
     err << "simulate: warning: " << warning << '\n';
-  std::ostream& csv = options.csv ? file : out;
+  std::ostream& csv = file ? *file : out;
   csv << std::setprecision(17) << "t,body,node,x,y,z\n";
-  writeRows(csv, world);
+  if (forces)
+    *forces << "t,body,anchor,fx,fy,fz,tx,ty,tz\n";
+  if (tensions)
+    *tensions << "t,body,kind,index,a,b,tension\n";
+  const auto record = [&] {
+    writeRows(csv, world);
+    if (forces)
+      writeForces(*forces, world);
+    if (tensions)
+      writeTensions(*tensions, world);
+  };
+  record();
   for (long long n = 1; n <= steps; ++n)
   {
     world.step();
     for (const DivergenceEvent& event : world.takeDivergenceEvents())
       err << "simulate: warning: " << event.describe() << '\n';
     if (n == steps || (options.every && n % *options.every == 0))
-      writeRows(csv, world);
+      record();
   }
   csv.flush();
-  if (!csv)
+  if (!csv || (forces && !forces->flush()) || (tensions && !tensions->flush()))
     throw UsageError("failed writing the CSV output");
 }
 }  // namespace

@@ -21,6 +21,13 @@ inline bool springAxis(const NodeArray& x, int a, int b, Vec3& u, double& length
   return true;
 }
 
+/// Spring s's tension [N] (> 0 stretched), k (|d| - rest_length) + c (v_a - v_b) . u, along its axis u
+/// of length |d| (springAxis): it pulls each end toward the other with this force (see Spring).
+inline double springTension(const Spring& s, const Vec3& u, double length, const NodeArray& v)
+{
+  return s.stiffness * (length - s.rest_length) + s.damping * (v.col(s.a) - v.col(s.b)).dot(u);
+}
+
 /// Adds every spring's Hooke + dashpot force [N] to `force` (see Spring).
 void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force);
 

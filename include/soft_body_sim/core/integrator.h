@@ -61,6 +61,12 @@ public:
   {
     step(model, state, h, iterations);
   }
+  /// Each link's tension [N] in the last sub-step, > 0 when stretched (it pulls each end toward the other
+  /// with that force): `tension` gets the model's springs, then its distance constraints, in model order.
+  /// The force-based schemes take the spring law at `state` and, for constraints, their constraint pass's
+  /// multipliers as forces -lambda / h^2; xpbd takes its multipliers for both. Before the first step: the
+  /// spring law, and 0 for constraints.
+  virtual void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const = 0;
   /// The state was changed from outside the integrator (an anchor or controller moved its nodes, a
   /// plane contact changed a velocity, a node was set): drop anything cached from the old state.
   virtual void invalidate() {}

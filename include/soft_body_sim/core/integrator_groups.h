@@ -34,6 +34,10 @@ public:
   /// none).
   void step(const Model& model, State& state, double h, int iterations, const ContactQuery* contacts);
 
+  /// Each link's tension [N] in the last sub-step, by the integrator stepping it (Integrator::linkTensions);
+  /// a link between two groups by the last of them.
+  void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const;
+
   /// The state was changed from outside the integrators: they drop what they cached from it.
   void invalidate();
   /// The model was changed: they drop what they cached from it, and the groups are made again.
@@ -45,6 +49,7 @@ private:
     IntegratorType type;
     Model model;
     std::unique_ptr<Integrator> integrator;
+    std::vector<std::size_t> links;  ///< per link of `model` (springs, then constraints): its index in the scene's
   };
 
   void rebuild(const Model& model);

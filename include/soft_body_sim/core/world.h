@@ -16,6 +16,7 @@
 #include "soft_body_sim/core/integrator_groups.h"
 #include "soft_body_sim/core/material.h"
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/reactions.h"
 #include "soft_body_sim/core/self_contacts.h"
 
 namespace soft_body_sim
@@ -122,6 +123,13 @@ public:
   bool detach(int anchor);
   /// True for an anchor made by attach.
   bool isAttached(int anchor) const { return anchors_.isAttached(anchor); }
+
+  // --- forces on what holds the bodies (reactions.h), worked out when asked ------------------------
+  /// Each link's tension [N] in the last sub-step, > 0 stretched: springs, then constraints, in model
+  /// order (Integrator::linkTensions).
+  Eigen::VectorXd linkTensions() const;
+  /// Per anchor of model().anchors, the wrench its body exerts on it, torque about its node.
+  std::vector<Wrench> anchorWrenches() const;
 
   /// Kinetic + potential energy [J] (see forces.h).
   double energy() const;

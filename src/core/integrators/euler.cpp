@@ -14,7 +14,7 @@ namespace
 ///      v_{n+1} = v_n + h a(x_n, v_n),   x_{n+1} = x_n + h v_{n+1};
 ///    an undamped oscillator stays bounded for w h < 2.
 template <bool kVelocityFirst>
-class Euler final : public Integrator
+class Euler final : public ForceBasedIntegrator
 {
 public:
   void step(const Model& model, State& state, double h, int iterations) override
@@ -36,7 +36,6 @@ public:
 private:
   NodeArray force_;
   NodeArray acceleration_;
-  ConstraintPass constraints_;
 };
 }  // namespace
 

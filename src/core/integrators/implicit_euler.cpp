@@ -38,7 +38,7 @@ using Matrix3 = Eigen::Matrix3d;
 /// node pairs couple) depends only on the springs, the cells and which nodes are pinned: it is analysed
 /// on the first step and after every model change, and each Newton iteration only writes its values and
 /// factorises. Every array is sized once: a step allocates nothing after the first.
-class ImplicitEuler final : public Integrator
+class ImplicitEuler final : public ForceBasedIntegrator
 {
 public:
   void modelChanged() override { analyzed_ = false; }
@@ -383,7 +383,6 @@ private:
   double condition_ = 1.0;         ///< estimate of block-Jacobi preconditioned A's condition number
   std::vector<int> spring_slot_;   ///< per spring: its slot in solver_, or -1 (not coupled)
   std::vector<int> cell_slot_;     ///< per cell, six: each corner pair's slot, or -1
-  ConstraintPass constraints_;
 };
 }  // namespace
 

@@ -63,15 +63,54 @@ public:
     if (model.constraints.empty())
       return;
     unprojected_ = state.position;
-    projectConstraints(model, h, iterations, unprojected_, state.position, lambda_);
+    project(model, h, iterations, unprojected_, state.position);
     for (int i = 0; i < model.nodeCount(); ++i)
       if (model.isFree(i))
         state.velocity.col(i) += (state.position.col(i) - unprojected_.col(i)) / h;
   }
 
+  /// Projects the constraints of `x` (x_prev: the positions at the sub-step's start, for damping) and
+  /// keeps the multipliers for tensions().
+  void project(const Model& model, double h, int iterations, const NodeArray& x_prev, NodeArray& x)
+  {
+    if (model.constraints.empty())
+      return;
+    projectConstraints(model, h, iterations, x_prev, x, lambda_);
+    h_ = h;
+  }
+
+  /// The constraints' tensions [N] in the last projection, -lambda / h^2 (a projection by w lambda u
+  /// is the displacement h^2 w F of a force F = lambda u / h^2), into `tension`, one per constraint.
+  void tensions(const Model& model, Eigen::Ref<Eigen::VectorXd> tension) const
+  {
+    if (lambda_.size() != static_cast<Eigen::Index>(model.constraints.size()) || h_ == 0.0)
+      tension.setZero();
+    else
+      tension = -lambda_ / (h_ * h_);
+  }
+
 private:
   NodeArray unprojected_;
   Eigen::VectorXd lambda_;
+  double h_ = 0.0;  ///< [s] of the last projection; 0 = none yet
+};
+
+/// The springs' tensions by the spring law at `state`, then 0 for each constraint (see
+/// Integrator::linkTensions).
+void springLawTensions(const Model& model, const State& state, Eigen::VectorXd& tension);
+
+/// A force-based scheme: springs and dashpots as forces, constraints by its ConstraintPass.
+class ForceBasedIntegrator : public Integrator
+{
+public:
+  void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const override
+  {
+    springLawTensions(model, state, tension);
+    constraints_.tensions(model, tension.tail(static_cast<Eigen::Index>(model.constraints.size())));
+  }
+
+protected:
+  ConstraintPass constraints_;
 };
 
 std::unique_ptr<Integrator> makeExplicitEuler();

@@ -10,7 +10,7 @@ namespace
 ///   y_{n+1} = y_n + h/6 (k1 + 2 k2 + 2 k3 + k4)
 /// Stages move pinned nodes along their own (kinematic) velocity, so a moving anchor is seen where it
 /// will be; the final update leaves them to the caller.
-class Rk4 final : public Integrator
+class Rk4 final : public ForceBasedIntegrator
 {
 public:
   void step(const Model& model, State& state, double h, int iterations) override
@@ -42,7 +42,6 @@ private:
   NodeArray stage_x_;
   NodeArray v2_, v3_, v4_;
   NodeArray a1_, a2_, a3_, a4_;
-  ConstraintPass constraints_;
 };
 }  // namespace
 

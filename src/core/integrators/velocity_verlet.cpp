@@ -10,7 +10,7 @@ namespace
 /// a_{n+1} depends on v_{n+1} through damping and drag; it is evaluated at the predictor
 /// v_n + h a_n, whose O(h^2) error enters v_{n+1} as O(h^3), keeping the scheme second order with
 /// one force evaluation per step. a_{n+1} is reused as the next step's a_n.
-class VelocityVerlet final : public Integrator
+class VelocityVerlet final : public ForceBasedIntegrator
 {
 public:
   void step(const Model& model, State& state, double h, int iterations) override
@@ -42,7 +42,6 @@ private:
   NodeArray force_;
   NodeArray acceleration_;
   NodeArray predicted_velocity_;
-  ConstraintPass constraints_;
 };
 }  // namespace
 

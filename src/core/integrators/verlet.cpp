@@ -15,7 +15,7 @@ namespace
 /// which is the same recurrence, and a velocity changed from outside (a plane contact, an anchor's
 /// pull) enters the next step as it should. Started with second-order accuracy: a_{-1} = a_0 gives
 /// x_1 = x_0 + h v_0 + h^2/2 a_0. The recurrence needs a constant h: a new h starts it again.
-class Verlet final : public Integrator
+class Verlet final : public ForceBasedIntegrator
 {
 public:
   void step(const Model& model, State& state, double h, int iterations) override
@@ -28,7 +28,7 @@ public:
       if (model.isFree(i))
         state.position.col(i) +=
             h * state.velocity.col(i) + h * h * (acceleration_.col(i) - 0.5 * previous_acceleration_.col(i));
-    projectConstraints(model, h, iterations, start_, state.position, lambda_);
+    constraints_.project(model, h, iterations, start_, state.position);
     for (int i = 0; i < model.nodeCount(); ++i)
       if (model.isFree(i))
         state.velocity.col(i) = (state.position.col(i) - start_.col(i)) / h + 0.5 * h * acceleration_.col(i);
@@ -44,7 +44,6 @@ private:
   NodeArray force_;
   NodeArray acceleration_;           ///< a_n [m/s^2]
   NodeArray previous_acceleration_;  ///< a_{n-1} [m/s^2]
-  Eigen::VectorXd lambda_;
 };
 }  // namespace
 

@@ -68,6 +68,18 @@ public:
     postSolve(model, state, h);
   }
 
+  void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const override
+  {
+    springLawTensions(model, state, tension);
+    if (solved_h_ == 0.0 || lambda_.size() != tension.size())
+      return;
+    // Row order_[k]'s multiplier moved its ends by w lambda u: the displacement h^2 w F of a force
+    // F = lambda u / h^2 on end a, a tension of -lambda / h^2.
+    const double inverse_h2 = 1.0 / (solved_h_ * solved_h_);
+    for (std::size_t k = 0; k < order_.size(); ++k)
+      tension[order_[k]] = -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2;
+  }
+
   /// The rows hold only the model's parameters and h, so a change of state (invalidate()) keeps them;
   /// a change of the model (stiffness, masses, an attached node) orders and builds them again.
   void modelChanged() override { reorder_ = true; }
@@ -150,6 +162,7 @@ private:
     // sub-step's geometric stiffness; compression adds none.
     for (std::size_t k = swept_count_; k < row_count; ++k)
       chain_tension_[static_cast<Eigen::Index>(k)] = std::max(0.0, -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2);
+    solved_h_ = h;
   }
 
   /// Every chain, one Newton step each (chain_solver.h), with the contacts' holds if `held` (their
@@ -294,7 +307,8 @@ private:
   std::vector<SweepRow> rows_;        ///< the rows in solve order, valid for h = rows_h_
   double rows_h_ = 0.0;               ///< [s]; 0 = rows not built
   bool reorder_ = false;              ///< the model changed: order and build the rows again
-  Eigen::VectorXd lambda_;
+  Eigen::VectorXd lambda_;            ///< per row in solve order, the last sub-step's multipliers
+  double solved_h_ = 0.0;             ///< [s] of the last sub-step solved; 0 = none yet
   Eigen::VectorXd cell_lambda_;
 };
 }  // namespace
