@@ -48,13 +48,14 @@ void World::step()
   {
     self_contacts_.remember(state_);  // before the anchors move: a dragged link slips past the others
     if (kinematic)
-      moveAnchors(h);
+      moveHeldNodes(substep + 1, h);
     integrate(h);
     resolveContacts(h);
     resolveSelfContacts();
   }
   landKinematics();
   ++steps_;
+  slipGrasps();
   guardBodies();
 }
 
@@ -64,12 +65,13 @@ bool World::driveKinematicNodes(double dt)
   for (BodyController& body : controllers_)
     if (!guard_.isFrozen(static_cast<std::size_t>(body.body)))  // a frozen body stands still, driven points too
       body.controller->step(dt, state_);
-  return anchors_.setVelocities(model_, state_, dt) || moved;
+  return anchors_.setVelocities(model_, state_, dt) || !grasps_.empty() || moved;
 }
 
-void World::moveAnchors(double h)
+void World::moveHeldNodes(int substep, double h)
 {
   AnchorSet::advance(model_, state_, h);
+  grasps_.advance(state_, substep, settings_.substeps, h);
   integrators_.invalidate();
 }
 
@@ -96,7 +98,26 @@ void World::resolveSelfContacts()
 void World::landKinematics()
 {
   anchors_.land(model_, state_);
+  grasps_.land();
   contacts_.land();
+}
+
+void World::slipGrasps()
+{
+  if (!grasps_.limited())
+    return;
+  const std::vector<Wrench> wrenches = graspWrenches();
+  // Released in reverse: a release moves the later grasps down one index.
+  for (std::size_t k = wrenches.size(); k-- > 0;)
+  {
+    const Grasp& g = grasps_.grasps()[k];
+    const double force = wrenches[k].force.norm();
+    if (force > g.max_force)
+    {
+      slips_.push_back(GraspSlip{ time(), g.name, model_.bodies[g.body].name, force, g.max_force });
+      release(slips_.back().grasp);
+    }
+  }
 }
 
 void World::guardBodies()
@@ -268,16 +289,49 @@ Eigen::VectorXd World::linkTensions() const
   return tension;
 }
 
+NodeArray World::pulls() const
+{
+  NodeArray pull;
+  linkPulls(model_, state_.position, linkTensions(), pull);
+  return pull;
+}
+
 std::vector<Wrench> World::anchorWrenches() const
 {
   std::vector<Wrench> wrenches;
   if (model_.anchors.empty())
     return wrenches;
-  NodeArray pull;
-  linkPulls(model_, state_.position, linkTensions(), pull);
+  const NodeArray pull = pulls();
   for (const Anchor& anchor : model_.anchors)
     wrenches.push_back(holdingWrench(model_, state_.position, pull, { anchor.node }, state_.position.col(anchor.node)));
   return wrenches;
+}
+
+std::vector<Wrench> World::graspWrenches() const
+{
+  if (grasps_.empty())
+    return {};
+  return grasps_.wrenches(model_, state_.position, pulls());
+}
+
+std::size_t World::grasp(const std::string& frame, const std::string& body, const RigidPose& pose, double radius,
+                         double max_force)
+{
+  const std::size_t held = grasps_.grasp(model_, state_, frame, body, pose, radius, max_force);
+  modelChanged();
+  return held;
+}
+
+bool World::release(const std::string& frame)
+{
+  for (const Grasp& g : grasps_.grasps())
+    if (g.name == frame)
+    {
+      grasps_.release(model_, frame, guard_.isFrozen(g.body));
+      modelChanged();
+      return true;
+    }
+  return false;
 }
 
 double World::energy() const { return kineticEnergy(model_, state_) + potentialEnergy(model_, state_); }

@@ -3,14 +3,17 @@
 
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "soft_body_sim/core/anchors.h"
 #include "soft_body_sim/core/contact.h"
 #include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/grasps.h"
 #include "soft_body_sim/core/guard.h"
 #include "soft_body_sim/core/integrator.h"
 #include "soft_body_sim/core/integrator_groups.h"
@@ -124,12 +127,27 @@ public:
   /// True for an anchor made by attach.
   bool isAttached(int anchor) const { return anchors_.isAttached(anchor); }
 
+  /// Grasps body `body` in frame `frame` at `pose` (GraspSet::grasp: every free node within `radius` [m] of
+  /// its origin, held at its offset in the frame; slips above `max_force` [N]). Returns the nodes held;
+  /// throws std::invalid_argument as GraspSet::grasp does.
+  std::size_t grasp(const std::string& frame, const std::string& body, const RigidPose& pose, double radius,
+                    double max_force = std::numeric_limits<double>::infinity());
+  /// The grasp of frame `frame` moves to `pose` during the next step (GraspSet::setGoal); false if none.
+  bool moveGrasp(const std::string& frame, const RigidPose& pose) { return grasps_.setGoal(frame, pose); }
+  /// Lets the grasp of frame `frame` go: its nodes keep their velocities (GraspSet::release); false if none.
+  bool release(const std::string& frame);
+  const std::vector<Grasp>& grasps() const { return grasps_.grasps(); }
+  /// The grasps that slipped since the last call, oldest first, for the caller to log.
+  std::vector<GraspSlip> takeGraspSlips() { return std::exchange(slips_, {}); }
+
   // --- forces on what holds the bodies (reactions.h), worked out when asked ------------------------
   /// Each link's tension [N] in the last sub-step, > 0 stretched: springs, then constraints, in model
   /// order (Integrator::linkTensions).
   Eigen::VectorXd linkTensions() const;
   /// Per anchor of model().anchors, the wrench its body exerts on it, torque about its node.
   std::vector<Wrench> anchorWrenches() const;
+  /// Per grasp of grasps(), the wrench its body exerts on it, torque about its frame's origin.
+  std::vector<Wrench> graspWrenches() const;
 
   /// Kinetic + potential energy [J] (see forces.h).
   double energy() const;
@@ -150,19 +168,23 @@ private:
   // The stages of step(), in their order.
   /// Controllers and anchors set their nodes for this step; true if any kinematic node moves.
   bool driveKinematicNodes(double dt);
-  /// Anchors move by one sub-step h [s].
-  void moveAnchors(double h);
+  /// Anchors and grasps move by sub-step `substep` (1 to substeps) of h [s].
+  void moveHeldNodes(int substep, double h);
   void integrate(double h);
   void resolveContacts(double h);
   /// Links of the bodies with self_collision keep apart.
   void resolveSelfContacts();
-  /// Anchors and path-driven colliders land on their goals.
+  /// Anchors, grasps and path-driven colliders land on their goals.
   void landKinematics();
+  /// Grasps whose force exceeds their max_force let go.
+  void slipGrasps();
   /// Checks every body, restores and treats the diverged ones, keeps the good state.
   void guardBodies();
 
   /// Applies the guard's policy to body `body` and says what it did.
   std::string treatDiverged(std::size_t body);
+  /// Per node, its links' pull (linkPulls).
+  NodeArray pulls() const;
   /// The model's parameters or pinning changed: the integrators drop their caches.
   void modelChanged() { integrators_.modelChanged(); }
 
@@ -171,6 +193,8 @@ private:
   StepSettings settings_;
   std::vector<BodyController> controllers_;
   AnchorSet anchors_;
+  GraspSet grasps_;
+  std::vector<GraspSlip> slips_;  ///< not yet taken
   IntegratorGroups integrators_;
   ContactStage contacts_;
   SelfContacts self_contacts_;

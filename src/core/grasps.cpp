@@ -1,0 +1,126 @@
+#include "soft_body_sim/core/grasps.h"
+
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+namespace soft_body_sim
+{
+std::string GraspSlip::describe() const
+{
+  char text[128];
+  std::snprintf(text, sizeof text, "' slipped at t = %.6g s: force %.6g N > max_force %.6g N", time, force, max_force);
+  return "grasp '" + grasp + "' on body '" + body + text;
+}
+
+std::size_t GraspSet::grasp(Model& model, const State& state, const std::string& name, const std::string& body,
+                            const RigidPose& pose, double radius, double max_force)
+{
+  for (const Grasp& g : grasps_)
+    if (g.name == name)
+      throw std::invalid_argument("there is a grasp '" + name + "' already (release it first)");
+  if (!(radius > 0.0 && std::isfinite(radius)))
+    throw std::invalid_argument("radius must be a finite number > 0 [m]");
+  if (!(max_force > 0.0))
+    throw std::invalid_argument("max_force must be > 0 [N] (infinity: no limit)");
+  std::size_t b = 0;
+  while (b < model.bodies.size() && model.bodies[b].name != body)
+    ++b;
+  if (b == model.bodies.size())
+    throw std::invalid_argument("there is no body '" + body + "'");
+  Grasp g{ name, b, {}, {}, pose, max_force };
+  const Eigen::Quaterniond to_frame = pose.orientation.conjugate();
+  const BodyRange& range = model.bodies[b];
+  for (int i = range.first; i < range.first + range.count; ++i)
+    if (model.isFree(i) && (state.position.col(i) - pose.position).norm() <= radius)
+    {
+      g.nodes.push_back(i);
+      g.offsets.push_back(to_frame * (state.position.col(i) - pose.position));
+    }
+  if (g.nodes.empty())
+    throw std::invalid_argument("no free node of body '" + body + "' within " + std::to_string(radius) + " m of the frame's origin");
+  // Pinned = inverse mass 0: from now on only the grasp moves them (Ten Minute Physics' grab).
+  for (const int node : g.nodes)
+    model.inverse_mass[node] = 0.0;
+  grasps_.push_back(std::move(g));
+  goals_.emplace_back();
+  return grasps_.back().nodes.size();
+}
+
+bool GraspSet::release(Model& model, const std::string& name, bool frozen)
+{
+  for (std::size_t k = 0; k < grasps_.size(); ++k)
+    if (grasps_[k].name == name)
+    {
+      for (const int node : grasps_[k].nodes)
+        model.inverse_mass[node] = frozen ? 0.0 : 1.0 / model.mass[node];
+      grasps_.erase(grasps_.begin() + static_cast<std::ptrdiff_t>(k));
+      goals_.erase(goals_.begin() + static_cast<std::ptrdiff_t>(k));
+      return true;
+    }
+  return false;
+}
+
+bool GraspSet::setGoal(const std::string& name, const RigidPose& pose)
+{
+  for (std::size_t k = 0; k < grasps_.size(); ++k)
+    if (grasps_[k].name == name)
+    {
+      goals_[k] = pose;
+      return true;
+    }
+  return false;
+}
+
+RigidPose GraspSet::at(std::size_t k, double s) const
+{
+  const RigidPose& from = grasps_[k].pose;
+  if (!goals_[k])
+    return from;
+  return RigidPose{ from.position + s * (goals_[k]->position - from.position),
+                    from.orientation.slerp(s, goals_[k]->orientation) };
+}
+
+void GraspSet::advance(State& state, int substep, int substeps, double h) const
+{
+  const double s = static_cast<double>(substep) / substeps;
+  for (std::size_t k = 0; k < grasps_.size(); ++k)
+  {
+    const Grasp& g = grasps_[k];
+    const RigidPose pose = at(k, s);
+    for (std::size_t n = 0; n < g.nodes.size(); ++n)
+    {
+      const Vec3 x = pose.position + pose.orientation * g.offsets[n];
+      state.velocity.col(g.nodes[n]) = (x - state.position.col(g.nodes[n])) / h;
+      state.position.col(g.nodes[n]) = x;
+    }
+  }
+}
+
+void GraspSet::land()
+{
+  for (std::size_t k = 0; k < grasps_.size(); ++k)
+    if (goals_[k])
+    {
+      grasps_[k].pose = *goals_[k];
+      goals_[k].reset();
+    }
+}
+
+std::vector<Wrench> GraspSet::wrenches(const Model& model, const NodeArray& x, const NodeArray& pull) const
+{
+  std::vector<Wrench> wrenches;
+  for (const Grasp& g : grasps_)
+    wrenches.push_back(holdingWrench(model, x, pull, g.nodes, g.pose.position));
+  return wrenches;
+}
+
+bool GraspSet::limited() const
+{
+  for (const Grasp& g : grasps_)
+    if (std::isfinite(g.max_force))
+      return true;
+  return false;
+}
+
+}  // namespace soft_body_sim
