@@ -2,6 +2,7 @@
 // that released nodes keep their velocities, the force a grasp carries, and that a grasp slips at the
 // step where its force first exceeds its limit.
 #include <cmath>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -89,7 +90,8 @@ TEST(Grasp, RefusesANameTakenNoNodeInReachAnUnknownBodyAndABadRadius)
 TEST(Grasp, TheGraspedNodesKeepTheirOffsetsWhileTheFrameTurnsNinetyDegrees)
 {
   // The gripper closes on a corner of the cloth, then turns by 90 degrees about its x axis in 30 steps
-  // while moving 0.2 m up, and holds: the grasped nodes stay where the frame carries them, to round-off.
+  // while moving 0.2 m up along a path (as a tf frame), and holds: the grasped nodes stay where the frame
+  // carries them, to round-off.
   for (const IntegratorType integrator : { IntegratorType::Xpbd, IntegratorType::ImplicitEuler })
   {
     World world = buildWorld(clothScene(integrator));
@@ -99,13 +101,15 @@ TEST(Grasp, TheGraspedNodesKeepTheirOffsetsWhileTheFrameTurnsNinetyDegrees)
     std::vector<Vec3> offsets;  // in the frame, which starts unrotated at `origin`
     for (const int node : nodes)
       offsets.push_back(world.state().position.col(node) - origin);
+    const auto path = [&](double t) -> std::optional<RigidPose> {
+      const double s = std::min(1.0, t / (30 * world.settings().dt));
+      return poseAt(origin + Vec3(0, 0, 0.2 * s), Eigen::Quaterniond(Eigen::AngleAxisd(s * M_PI / 2, Vec3::UnitX())));
+    };
+    ASSERT_TRUE(world.followGraspPath("gripper", path));
     for (int n = 1; n <= 60; ++n)
     {
-      const double s = std::min(1.0, n / 30.0);
-      const RigidPose pose =
-          poseAt(origin + Vec3(0, 0, 0.2 * s), Eigen::Quaterniond(Eigen::AngleAxisd(s * M_PI / 2, Vec3::UnitX())));
-      world.moveGrasp("gripper", pose);
       world.step();
+      const RigidPose pose = *path(world.time());
       for (std::size_t k = 0; k < nodes.size(); ++k)
         ASSERT_TRUE(expectNear(world.state().position.col(nodes[k]),
                                Vec3(pose.position + pose.orientation * offsets[k]), 1e-9))

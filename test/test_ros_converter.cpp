@@ -106,6 +106,68 @@ TEST(RosConverter, StateSaysWhatTheDivergenceGuardDidToEachBody)
   EXPECT_FALSE(state.bodies[1].frozen);
 }
 
+TEST(RosConverter, HoldersAreTheAnchorsThenTheGraspsWithTheirWrenchesInStateMarkersAndWrenchMessages)
+{
+  // A 2 kg mass hangs at rest 1 m below an anchored 0.5 kg node on a spring stretched by its weight; a
+  // grasp holds the rope's end. The anchor carries both weights; the spring's tension is the mass's weight.
+  SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 1e-3);
+  scene.physics.gravity = Vec3(0, 0, -10.0);
+  RopeDef rope;
+  rope.nodes = 4;
+  rope.from = Vec3(0, 0, 1);
+  rope.to = Vec3(0.3, 0, 1);
+  scene.bodies[0] = buildRope("rope", rope);
+  BodyDef weight;
+  weight.name = "weight";
+  weight.nodes = { NodeDef{ Vec3(0, 0, 0), 0.5, Vec3::Zero(), true }, NodeDef{ Vec3(0, 0, -1.2), 2.0 } };
+  weight.springs = { SpringDef{ 0, 1, 100.0, 0.0, 1.0 } };
+  weight.anchors = { AnchorDef("hook", 0) };
+  scene.bodies.push_back(weight);
+  World world = buildWorld(scene);
+  world.grasp("gripper", "rope", RigidPose{ Vec3(0.3, 0, 1), Eigen::Quaterniond::Identity() }, 0.01);
+  const std::vector<Holder> holders = RosConverter::holders(world);
+  ASSERT_EQ(holders.size(), 2u);
+  EXPECT_EQ(holders[0].name, "hook");
+  EXPECT_EQ(holders[0].body, 1u);
+  EXPECT_TRUE(expectNear(holders[0].wrench.force, Vec3(0, 0, -25.0), 1e-12));
+  EXPECT_EQ(holders[1].name, "gripper");
+  EXPECT_EQ(holders[1].body, 0u);
+  EXPECT_TRUE(expectNear(holders[1].origin, Vec3(0.3, 0, 1), 0.0));
+
+  const GraspSlip slip{ 1.5, "other", "weight", 3.0, 2.0 };
+  const SimState state = RosConverter::toState(world, "map", ros::Time(3.0), StepStatistics{}, holders, { slip });
+  ASSERT_EQ(state.bodies.size(), 2u);
+  EXPECT_EQ(state.bodies[0].holders, std::vector<std::string>{ "gripper" });
+  EXPECT_EQ(state.bodies[1].holders, std::vector<std::string>{ "hook" });
+  ASSERT_EQ(state.bodies[1].wrenches.size(), 1u);
+  EXPECT_DOUBLE_EQ(state.bodies[1].wrenches[0].force.z, -25.0);
+  EXPECT_EQ(state.bodies[0].tensions.size(), 3u);  // the rope's three segments
+  ASSERT_EQ(state.bodies[1].tensions.size(), 1u);
+  EXPECT_NEAR(state.bodies[1].tensions[0], 20.0, 1e-12);
+  EXPECT_TRUE(state.bodies[0].slips.empty());
+  EXPECT_EQ(state.bodies[1].slips,
+            std::vector<std::string>{ "grasp 'other' on body 'weight' slipped at t = 1.5 s: force 3 N > max_force 2 N" });
+
+  const visualization_msgs::MarkerArray arrows = RosConverter::toForceMarkers(holders, 0.02, "map", ros::Time(3.0));
+  ASSERT_EQ(arrows.markers.size(), 3u);
+  EXPECT_EQ(arrows.markers[0].action, visualization_msgs::Marker::DELETEALL);  // arrows of holders gone
+  for (const visualization_msgs::Marker& m : arrows.markers)
+    EXPECT_EQ(m.ns, "forces");
+  const visualization_msgs::Marker& hook = arrows.markers[1];
+  EXPECT_EQ(hook.type, visualization_msgs::Marker::ARROW);
+  EXPECT_EQ(hook.action, visualization_msgs::Marker::ADD);
+  EXPECT_EQ(hook.header.frame_id, "map");
+  ASSERT_EQ(hook.points.size(), 2u);
+  EXPECT_DOUBLE_EQ(hook.points[0].z, 0.0);
+  EXPECT_DOUBLE_EQ(hook.points[1].z, -0.5);  // 25 N at 0.02 m/N
+
+  const geometry_msgs::WrenchStamped wrench = RosConverter::toWrench(holders[0].wrench, "map", ros::Time(3.0));
+  EXPECT_EQ(wrench.header.frame_id, "map");
+  EXPECT_EQ(wrench.header.stamp, ros::Time(3.0));
+  EXPECT_DOUBLE_EQ(wrench.wrench.force.z, -25.0);
+  EXPECT_DOUBLE_EQ(wrench.wrench.torque.x, 0.0);
+}
+
 TEST(RosConverter, CollidersAreDrawnInTheirCurrentPoseWithTheirExtents)
 {
   SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 0.5);

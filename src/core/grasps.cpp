@@ -16,9 +16,8 @@ std::string GraspSlip::describe() const
 std::size_t GraspSet::grasp(Model& model, const State& state, const std::string& name, const std::string& body,
                             const RigidPose& pose, double radius, double max_force)
 {
-  for (const Grasp& g : grasps_)
-    if (g.name == name)
-      throw std::invalid_argument("there is a grasp '" + name + "' already (release it first)");
+  if (find(name) < grasps_.size())
+    throw std::invalid_argument("there is a grasp '" + name + "' already (release it first)");
   if (!(radius > 0.0 && std::isfinite(radius)))
     throw std::invalid_argument("radius must be a finite number > 0 [m]");
   if (!(max_force > 0.0))
@@ -28,7 +27,7 @@ std::size_t GraspSet::grasp(Model& model, const State& state, const std::string&
     ++b;
   if (b == model.bodies.size())
     throw std::invalid_argument("there is no body '" + body + "'");
-  Grasp g{ name, b, {}, {}, pose, max_force };
+  GraspedNodes g{ name, b, {}, {}, pose, max_force };
   const Eigen::Quaterniond to_frame = pose.orientation.conjugate();
   const BodyRange& range = model.bodies[b];
   for (int i = range.first; i < range.first + range.count; ++i)
@@ -44,32 +43,55 @@ std::size_t GraspSet::grasp(Model& model, const State& state, const std::string&
     model.inverse_mass[node] = 0.0;
   grasps_.push_back(std::move(g));
   goals_.emplace_back();
+  paths_.emplace_back();
   return grasps_.back().nodes.size();
 }
 
 bool GraspSet::release(Model& model, const std::string& name, bool frozen)
 {
-  for (std::size_t k = 0; k < grasps_.size(); ++k)
-    if (grasps_[k].name == name)
-    {
-      for (const int node : grasps_[k].nodes)
-        model.inverse_mass[node] = frozen ? 0.0 : 1.0 / model.mass[node];
-      grasps_.erase(grasps_.begin() + static_cast<std::ptrdiff_t>(k));
-      goals_.erase(goals_.begin() + static_cast<std::ptrdiff_t>(k));
-      return true;
-    }
-  return false;
+  const std::size_t k = find(name);
+  if (k == grasps_.size())
+    return false;
+  for (const int node : grasps_[k].nodes)
+    model.inverse_mass[node] = frozen ? 0.0 : 1.0 / model.mass[node];
+  const auto at = static_cast<std::ptrdiff_t>(k);
+  grasps_.erase(grasps_.begin() + at);
+  goals_.erase(goals_.begin() + at);
+  paths_.erase(paths_.begin() + at);
+  return true;
 }
 
 bool GraspSet::setGoal(const std::string& name, const RigidPose& pose)
 {
+  const std::size_t k = find(name);
+  if (k == grasps_.size())
+    return false;
+  goals_[k] = pose;
+  return true;
+}
+
+bool GraspSet::followPath(const std::string& name, GraspPath path)
+{
+  const std::size_t k = find(name);
+  if (k == grasps_.size())
+    return false;
+  paths_[k] = std::move(path);
+  return true;
+}
+
+void GraspSet::goalsFromPaths(double t)
+{
   for (std::size_t k = 0; k < grasps_.size(); ++k)
-    if (grasps_[k].name == name)
-    {
-      goals_[k] = pose;
-      return true;
-    }
-  return false;
+    if (paths_[k] && !goals_[k])
+      goals_[k] = paths_[k](t);
+}
+
+std::size_t GraspSet::find(const std::string& name) const
+{
+  std::size_t k = 0;
+  while (k < grasps_.size() && grasps_[k].name != name)
+    ++k;
+  return k;
 }
 
 RigidPose GraspSet::at(std::size_t k, double s) const
@@ -86,7 +108,7 @@ void GraspSet::advance(State& state, int substep, int substeps, double h) const
   const double s = static_cast<double>(substep) / substeps;
   for (std::size_t k = 0; k < grasps_.size(); ++k)
   {
-    const Grasp& g = grasps_[k];
+    const GraspedNodes& g = grasps_[k];
     const RigidPose pose = at(k, s);
     for (std::size_t n = 0; n < g.nodes.size(); ++n)
     {
@@ -110,14 +132,14 @@ void GraspSet::land()
 std::vector<Wrench> GraspSet::wrenches(const Model& model, const NodeArray& x, const NodeArray& pull) const
 {
   std::vector<Wrench> wrenches;
-  for (const Grasp& g : grasps_)
+  for (const GraspedNodes& g : grasps_)
     wrenches.push_back(holdingWrench(model, x, pull, g.nodes, g.pose.position));
   return wrenches;
 }
 
 bool GraspSet::limited() const
 {
-  for (const Grasp& g : grasps_)
+  for (const GraspedNodes& g : grasps_)
     if (std::isfinite(g.max_force))
       return true;
   return false;

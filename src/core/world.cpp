@@ -42,6 +42,7 @@ void World::step()
   const double h = dt / settings_.substeps;
   integrators_.prepare(model_);
   anchors_.goalsFromPaths(time() + dt);
+  grasps_.goalsFromPaths(time() + dt);
   contacts_.goalsFromPaths(time() + dt, dt);
   const bool kinematic = driveKinematicNodes(dt);
   for (int substep = 0; substep < settings_.substeps; ++substep)
@@ -110,7 +111,7 @@ void World::slipGrasps()
   // Released in reverse: a release moves the later grasps down one index.
   for (std::size_t k = wrenches.size(); k-- > 0;)
   {
-    const Grasp& g = grasps_.grasps()[k];
+    const GraspedNodes& g = grasps_.grasps()[k];
     const double force = wrenches[k].force.norm();
     if (force > g.max_force)
     {
@@ -324,7 +325,7 @@ std::size_t World::grasp(const std::string& frame, const std::string& body, cons
 
 bool World::release(const std::string& frame)
 {
-  for (const Grasp& g : grasps_.grasps())
+  for (const GraspedNodes& g : grasps_.grasps())
     if (g.name == frame)
     {
       grasps_.release(model_, frame, guard_.isFrozen(g.body));

@@ -119,6 +119,16 @@ void addSegment(const NodeArray& x, int a, int b, visualization_msgs::Marker& li
   lines.points.push_back(point(x.col(a)));
   lines.points.push_back(point(x.col(b)));
 }
+
+geometry_msgs::Vector3 vector3(const Vec3& v)
+{
+  geometry_msgs::Vector3 out;
+  out.x = v.x();
+  out.y = v.y();
+  out.z = v.z();
+  return out;
+}
+
 }  // namespace
 
 visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, const std::string& frame_id,
@@ -174,9 +184,64 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
   return array;
 }
 
-SimState RosConverter::toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
-                               const StepStatistics& statistics)
+visualization_msgs::MarkerArray RosConverter::toForceMarkers(const std::vector<Holder>& holders, double force_scale,
+                                                             const std::string& frame_id, const ros::Time& stamp)
 {
+  visualization_msgs::MarkerArray array;
+  // White: no body's hue (bodyColor), and brighter than the colliders' grey.
+  std_msgs::ColorRGBA white;
+  white.r = white.g = white.b = white.a = 1.0f;
+  array.markers.push_back(marker(frame_id, stamp, "forces", 0, visualization_msgs::Marker::ARROW, 1.0, white));
+  array.markers.back().action = visualization_msgs::Marker::DELETEALL;
+  for (std::size_t k = 0; k < holders.size(); ++k)
+  {
+    visualization_msgs::Marker arrow =
+        marker(frame_id, stamp, "forces", static_cast<int>(k), visualization_msgs::Marker::ARROW, 1.0, white);
+    arrow.scale.x = kLineWidth;        // shaft diameter [m]
+    arrow.scale.y = 2.0 * kLineWidth;  // head diameter
+    arrow.scale.z = 0.0;               // head length: rviz's default share of the arrow
+    arrow.points = { point(holders[k].origin), point(holders[k].origin + force_scale * holders[k].wrench.force) };
+    array.markers.push_back(arrow);
+  }
+  return array;
+}
+
+std::vector<Holder> RosConverter::holders(const World& world)
+{
+  std::vector<Holder> holders;
+  const Model& model = world.model();
+  const std::vector<Wrench> anchors = world.anchorWrenches();
+  for (std::size_t k = 0; k < anchors.size(); ++k)
+  {
+    const Anchor& anchor = model.anchors[k];
+    holders.push_back({ model.bodyOf(anchor.node), anchor.name, world.state().position.col(anchor.node), anchors[k] });
+  }
+  const std::vector<Wrench> grasps = world.graspWrenches();
+  for (std::size_t k = 0; k < grasps.size(); ++k)
+  {
+    const GraspedNodes& grasp = world.grasps()[k];
+    holders.push_back({ grasp.body, grasp.name, grasp.pose.position, grasps[k] });
+  }
+  return holders;
+}
+
+geometry_msgs::WrenchStamped RosConverter::toWrench(const Wrench& wrench, const std::string& frame_id,
+                                                    const ros::Time& stamp)
+{
+  geometry_msgs::WrenchStamped out;
+  out.header.frame_id = frame_id;
+  out.header.stamp = stamp;
+  out.wrench.force = vector3(wrench.force);
+  out.wrench.torque = vector3(wrench.torque);
+  return out;
+}
+
+SimState RosConverter::toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
+                               const StepStatistics& statistics, const std::vector<Holder>& holders,
+                               const std::vector<GraspSlip>& slips)
+{
+  const Model& model = world.model();
+  const Eigen::VectorXd tension = world.linkTensions();
   SimState state;
   state.header.frame_id = frame_id;
   state.header.stamp = stamp;
@@ -194,14 +259,28 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
     for (int i = range.first; i < range.first + range.count; ++i)
     {
       body.positions.push_back(point(world.state().position.col(i)));
-      geometry_msgs::Vector3 v;
-      v.x = world.state().velocity(0, i);
-      v.y = world.state().velocity(1, i);
-      v.z = world.state().velocity(2, i);
-      body.velocities.push_back(v);
+      body.velocities.push_back(vector3(world.state().velocity.col(i)));
     }
+    for (const Holder& holder : holders)
+      if (holder.body == b)
+      {
+        body.holders.push_back(holder.name);
+        geometry_msgs::Wrench wrench;
+        wrench.force = vector3(holder.wrench.force);
+        wrench.torque = vector3(holder.wrench.torque);
+        body.wrenches.push_back(wrench);
+      }
+    for (const GraspSlip& slip : slips)
+      if (slip.body == range.name)
+        body.slips.push_back(slip.describe());
     state.bodies.push_back(body);
   }
+  // A link belongs to the body of its first node; buildWorld adds each body's links in order.
+  for (std::size_t k = 0; k < model.springs.size(); ++k)
+    state.bodies[model.bodyOf(model.springs[k].a)].tensions.push_back(tension[static_cast<Eigen::Index>(k)]);
+  for (std::size_t k = 0; k < model.constraints.size(); ++k)
+    state.bodies[model.bodyOf(model.constraints[k].a)].tensions.push_back(
+        tension[static_cast<Eigen::Index>(model.springs.size() + k)]);
   return state;
 }
 

@@ -40,6 +40,8 @@ void SimNode::initialize()
   if (private_nh_.getParam("rate", rate_) && !(rate_ > 0.0 && std::isfinite(rate_)))
     throw std::runtime_error(private_nh_.resolveName("rate") + ": must be a finite number > 0 [Hz]");
   private_nh_.param("status_period", status_period_, 0.0);
+  if (private_nh_.getParam("force_scale", force_scale_) && !(force_scale_ > 0.0 && std::isfinite(force_scale_)))
+    throw std::runtime_error(private_nh_.resolveName("force_scale") + ": must be a finite number > 0 [m/N]");
   double start_time = 0.0;
   if (private_nh_.getParam("start_time", start_time) && start_time != 0.0)
   {
@@ -50,6 +52,7 @@ void SimNode::initialize()
   buildWorldFromScene();
 
   markers_publisher_ = private_nh_.advertise<visualization_msgs::MarkerArray>("markers", 1);
+  force_markers_publisher_ = private_nh_.advertise<visualization_msgs::MarkerArray>("force_markers", 1);
   state_publisher_ = private_nh_.advertise<SimState>("state", 10);
   start_time_publisher_ = private_nh_.advertise<std_msgs::Time>("start_time", 1, true);
   subscribeInputs();
@@ -62,6 +65,8 @@ void SimNode::initialize()
   pause_service_ = private_nh_.advertiseService("pause", &SimNode::onPause, this);
   attach_service_ = private_nh_.advertiseService("attach", &SimNode::onAttach, this);
   detach_service_ = private_nh_.advertiseService("detach", &SimNode::onDetach, this);
+  grasp_service_ = private_nh_.advertiseService("grasp", &SimNode::onGrasp, this);
+  release_service_ = private_nh_.advertiseService("release", &SimNode::onRelease, this);
   timer_ = nh_.createTimer(ros::Duration(1.0 / rate_), &SimNode::onTimer, this);
   ROS_INFO("%s: scene %s, %d nodes in %zu bodies, %s at dt = %g s, publishing at %g Hz in frame '%s'", name_.c_str(),
            scene_path_.c_str(), world_->model().nodeCount(), world_->model().bodies.size(),
@@ -137,6 +142,7 @@ void SimNode::onTimer(const ros::TimerEvent&)
     start_time_publisher_.publish(message);
   }
   watchDivergence();
+  watchGrasps();
   publish();
   diagnostics_->update();
   if (status_period_ > 0.0 && (now - last_status_).toSec() >= status_period_)
@@ -195,8 +201,12 @@ void SimNode::publish()
                        name_.c_str());
     return;
   }
+  const std::vector<Holder> holders = RosConverter::holders(*world_);
   markers_publisher_.publish(RosConverter::toMarkers(*world_, scene_.frame_id, stamp));
-  state_publisher_.publish(RosConverter::toState(*world_, scene_.frame_id, stamp, statistics_));
+  force_markers_publisher_.publish(RosConverter::toForceMarkers(holders, force_scale_, scene_.frame_id, stamp));
+  state_publisher_.publish(RosConverter::toState(*world_, scene_.frame_id, stamp, statistics_, holders, slips_));
+  slips_.clear();
+  publishWrenches(holders, stamp);
   for (std::size_t k = 0; k < handle_names_.size(); ++k)
     if (!handle_names_[k].empty())
       handles_->follow(handle_names_[k], state.position.col(world_->model().anchors[k].node));
@@ -207,12 +217,29 @@ void SimNode::publish()
   handles_->applyChanges();
 }
 
+void SimNode::publishWrenches(const std::vector<Holder>& holders, const ros::Time& stamp)
+{
+  std::map<std::string, ros::Publisher> publishers;
+  for (const Holder& holder : holders)
+  {
+    const std::string topic = world_->model().bodies[holder.body].name + "/" + holder.name + "/wrench";
+    auto found = wrench_publishers_.find(topic);
+    ros::Publisher publisher = found != wrench_publishers_.end()
+                                   ? found->second
+                                   : private_nh_.advertise<geometry_msgs::WrenchStamped>(topic, 10);
+    publisher.publish(RosConverter::toWrench(holder.wrench, scene_.frame_id, stamp));
+    publishers.emplace(topic, publisher);
+  }
+  wrench_publishers_.swap(publishers);  // the topics of holders gone are no longer advertised
+}
+
 bool SimNode::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
 {
   buildWorldFromScene();
   if (started_)
     epoch_ = last_tick_;
-  ROS_INFO("%s: reset to the initial scene (attached nodes released; live tuning kept)", name_.c_str());
+  slips_.clear();
+  ROS_INFO("%s: reset to the initial scene (attached and grasped nodes released; live tuning kept)", name_.c_str());
   return true;
 }
 

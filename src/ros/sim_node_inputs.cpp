@@ -1,9 +1,10 @@
 // SimNode's inputs: pose topics and rviz handles scheduled by stamp, anchors following tf frames, and
-// grasping with ~attach / ~detach. Whatever arrives is checked before it reaches the world: a refused
+// grasping with ~attach / ~detach (one node) and ~grasp / ~release (a gripper's width). Whatever arrives is checked before it reaches the world: a refused
 // input or request is named in a (throttled) warning and changes nothing.
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
@@ -366,6 +367,65 @@ bool SimNode::onDetach(Detach::Request& request, Detach::Response& response)
       return true;
     }
   return refuse("frame '" + request.frame + "' holds nothing");
+}
+
+bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
+{
+  const auto refuse = [&](const std::string& why) {
+    response.success = false;
+    response.message = why;
+    ROS_WARN("%s: grasp refused: %s", name_.c_str(), why.c_str());
+    return true;
+  };
+  if (request.frame.empty())
+    return refuse("no frame given");
+  if (request.body.empty())
+    return refuse("no body given");
+  for (const std::string& why : { badName("frame name", request.frame), badName("body name", request.body) })
+    if (!why.empty())
+      return refuse(why);
+  if (!(request.max_force >= 0.0 && std::isfinite(request.max_force)))
+    return refuse("max_force must be a finite number >= 0 [N] (0: no limit), not " + std::to_string(request.max_force));
+  const std::optional<RigidPose> pose = framePose(request.frame, ros::Time(0));
+  if (!pose)
+    return refuse("no transform from '" + request.frame + "' to '" + scene_.frame_id + "'");
+  const double max_force = request.max_force > 0.0 ? request.max_force : std::numeric_limits<double>::infinity();
+  try
+  {
+    world_->grasp(request.frame, request.body, *pose, request.radius, max_force);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    return refuse(e.what());
+  }
+  const std::string frame = request.frame;
+  world_->followGraspPath(frame, [this, frame](double t) { return framePose(frame, rosTime(t)); });
+  const GraspedNodes& grasp = world_->grasps().back();
+  const int first = world_->model().bodies[grasp.body].first;
+  for (const int node : grasp.nodes)
+    response.nodes.push_back(node - first);
+  response.success = true;
+  response.message = "'" + request.frame + "' holds " + std::to_string(grasp.nodes.size()) + " node(s) of '" +
+                     request.body + "'" +
+                     (request.max_force > 0.0 ? " up to " + std::to_string(request.max_force) + " N" : std::string());
+  ROS_INFO("%s: %s", name_.c_str(), response.message.c_str());
+  return true;
+}
+
+bool SimNode::onRelease(Detach::Request& request, Detach::Response& response)
+{
+  const std::string why = request.frame.empty() ? "no frame given" : badName("frame name", request.frame);
+  if (!why.empty() || !world_->release(request.frame))
+  {
+    response.success = false;
+    response.message = !why.empty() ? why : "frame '" + request.frame + "' holds no grasp";
+    ROS_WARN("%s: release refused: %s", name_.c_str(), response.message.c_str());
+    return true;
+  }
+  response.success = true;
+  response.message = "'" + request.frame + "' released its grasp";
+  ROS_INFO("%s: %s", name_.c_str(), response.message.c_str());
+  return true;
 }
 
 }  // namespace soft_body_sim

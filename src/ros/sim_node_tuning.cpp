@@ -96,6 +96,15 @@ void SimNode::watchDivergence()
   }
 }
 
+void SimNode::watchGrasps()
+{
+  for (GraspSlip& slip : world_->takeGraspSlips())
+  {
+    ROS_WARN("%s: %s; its nodes are free again", name_.c_str(), slip.describe().c_str());
+    slips_.push_back(std::move(slip));
+  }
+}
+
 void SimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
 {
   std::string frozen;

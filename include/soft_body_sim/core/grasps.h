@@ -16,8 +16,11 @@
 
 namespace soft_body_sim
 {
+/// Where a grasp's frame should be at simulated time t [s]; nullopt leaves it where it is.
+using GraspPath = ColliderPath;
+
 /// One grasp: its nodes and their offsets in its frame.
-struct Grasp
+struct GraspedNodes
 {
   std::string name;  ///< the frame's name; one grasp per name
   std::size_t body = 0;  ///< index into Model::bodies
@@ -54,9 +57,15 @@ public:
   /// Grasp `name`'s frame moves to `pose` during the next step; the latest call before a step wins. False if
   /// there is none of that name.
   bool setGoal(const std::string& name, const RigidPose& pose);
+  /// Grasp `name`'s frame follows path(t) every step (a tf frame); a goal set for a step overrides it.
+  /// False if there is none of that name.
+  bool followPath(const std::string& name, GraspPath path);
+
+  /// Stage: the grasps without a goal for the step ending at t [s] take their path's.
+  void goalsFromPaths(double t);
 
   bool empty() const { return grasps_.empty(); }
-  const std::vector<Grasp>& grasps() const { return grasps_; }
+  const std::vector<GraspedNodes>& grasps() const { return grasps_; }
 
   /// Stage, per sub-step `substep` (1 to `substeps`) of h [s]: each grasp's frame is at fraction
   /// substep / substeps of its way to its goal (position linear, orientation by slerp: constant linear and
@@ -76,8 +85,11 @@ private:
   /// The pose at fraction s in [0, 1] of grasp k's way to its goal.
   RigidPose at(std::size_t k, double s) const;
 
-  std::vector<Grasp> grasps_;
+  std::vector<GraspedNodes> grasps_;
   std::vector<std::optional<RigidPose>> goals_;  ///< per grasp: where its frame is at the next step's end
+  std::vector<GraspPath> paths_;                 ///< per grasp: followed every step if set
+  /// Index of grasp `name`, or grasps_.size().
+  std::size_t find(const std::string& name) const;
 };
 
 }  // namespace soft_body_sim

@@ -134,9 +134,12 @@ public:
                     double max_force = std::numeric_limits<double>::infinity());
   /// The grasp of frame `frame` moves to `pose` during the next step (GraspSet::setGoal); false if none.
   bool moveGrasp(const std::string& frame, const RigidPose& pose) { return grasps_.setGoal(frame, pose); }
+  /// Every step, the grasp of frame `frame` moves (as by moveGrasp) to path(t) at the step's end time t;
+  /// false if there is none.
+  bool followGraspPath(const std::string& frame, GraspPath path) { return grasps_.followPath(frame, std::move(path)); }
   /// Lets the grasp of frame `frame` go: its nodes keep their velocities (GraspSet::release); false if none.
   bool release(const std::string& frame);
-  const std::vector<Grasp>& grasps() const { return grasps_.grasps(); }
+  const std::vector<GraspedNodes>& grasps() const { return grasps_.grasps(); }
   /// The grasps that slipped since the last call, oldest first, for the caller to log.
   std::vector<GraspSlip> takeGraspSlips() { return std::exchange(slips_, {}); }
 

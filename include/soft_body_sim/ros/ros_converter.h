@@ -4,12 +4,14 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <optional>
 
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Transform.h>
 #include <geometry_msgs/Vector3.h>
+#include <geometry_msgs/WrenchStamped.h>
 #include <ros/time.h>
 #include <visualization_msgs/MarkerArray.h>
 
@@ -28,6 +30,15 @@ struct StepStatistics
   unsigned divergence_events = 0;      ///< catches of the divergence guard since the node started
 };
 
+/// What holds a body, an anchor or a grasp, and the wrench the body exerts on it.
+struct Holder
+{
+  std::size_t body = 0;  ///< index into Model::bodies
+  std::string name;      ///< the anchor's name or the grasp's frame
+  Vec3 origin = Vec3::Zero();  ///< [m] the anchor's node or the grasp frame's origin: the torque's point
+  Wrench wrench;
+};
+
 class RosConverter
 {
 public:
@@ -39,11 +50,21 @@ public:
   /// without points (a body without springs) is sent with action DELETE.
   static visualization_msgs::MarkerArray toMarkers(const World& world, const std::string& frame_id,
                                                    const ros::Time& stamp);
+  /// The forces on the holders (see holders()): a DELETEALL (arrows of holders gone disappear), then in
+  /// namespace "forces" per holder k, id k, an ARROW from its origin along the force the body exerts on
+  /// it, force_scale [m/N] long.
+  static visualization_msgs::MarkerArray toForceMarkers(const std::vector<Holder>& holders, double force_scale,
+                                                        const std::string& frame_id, const ros::Time& stamp);
 
-  /// The state: per body its name, positions [m], velocities [m/s], integrator and what the divergence
-  /// guard did to it; and the step statistics.
+  /// The state: per body its name, positions [m], velocities [m/s], integrator, what the divergence guard
+  /// did to it, its holders (`holders`, see holders()) and their wrenches, its links' tensions and the
+  /// `slips` of its grasps; and the step statistics.
   static SimState toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
-                          const StepStatistics& statistics);
+                          const StepStatistics& statistics, const std::vector<Holder>& holders = {},
+                          const std::vector<GraspSlip>& slips = {});
+  /// Every anchor (model order), then every grasp, with the wrench its body exerts on it.
+  static std::vector<Holder> holders(const World& world);
+  static geometry_msgs::WrenchStamped toWrench(const Wrench& wrench, const std::string& frame_id, const ros::Time& stamp);
 
   /// The position [m] of a pose; false (and why) if any field of the pose is NaN or infinite.
   static bool fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why);

@@ -1,11 +1,13 @@
 // The ROS node over the core: a timer advances the World in fixed steps and publishes markers, state
 // and diagnostics; anchor and target poses arrive on topics (or from rviz handles) in any tf frame and
 // take effect at the step their stamp falls in; anchors may follow tf frames; dynamic_reconfigure tunes
-// the physics live; services reset, pause, attach and detach. The same class runs as a node
+// the physics live; services reset, pause, attach, detach, grasp and release; each anchor's and grasp's
+// wrench is published. The same class runs as a node
 // (sim_node_main.cpp) and as a nodelet (sim_nodelet.cpp).
 #pragma once
 
 #include <chrono>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -23,6 +25,7 @@
 #include "soft_body_sim/Attach.h"
 #include "soft_body_sim/BodyConfig.h"
 #include "soft_body_sim/Detach.h"
+#include "soft_body_sim/Grasp.h"
 #include "soft_body_sim/SimConfig.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/ros/anchor_handles.h"
@@ -84,6 +87,11 @@ private:
   void followFrame(const ColliderPlacement& collider);
   bool onAttach(Attach::Request& request, Attach::Response& response);
   bool onDetach(Detach::Request& request, Detach::Response& response);
+  bool onGrasp(Grasp::Request& request, Grasp::Response& response);
+  bool onRelease(Detach::Request& request, Detach::Response& response);
+  /// Publishes each holder's wrench on ~<body>/<name>/wrench, advertising new holders' topics and
+  /// dropping those of holders gone.
+  void publishWrenches(const std::vector<Holder>& holders, const ros::Time& stamp);
 
   // --- tuning and health (sim_node_tuning.cpp)
   void startReconfigure();
@@ -93,6 +101,8 @@ private:
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   /// Logs the divergence guard's catches of the last tick and measures the largest strain.
   void watchDivergence();
+  /// Logs the grasps that slipped in the last tick and keeps them for the next state message.
+  void watchGrasps();
 
   bool onReset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
@@ -110,6 +120,7 @@ private:
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
   ros::Publisher markers_publisher_;
+  ros::Publisher force_markers_publisher_;
   ros::Publisher state_publisher_;
   ros::Publisher start_time_publisher_;
   std::vector<ros::Subscriber> subscribers_;
@@ -117,6 +128,9 @@ private:
   ros::ServiceServer pause_service_;
   ros::ServiceServer attach_service_;
   ros::ServiceServer detach_service_;
+  ros::ServiceServer grasp_service_;
+  ros::ServiceServer release_service_;
+  std::map<std::string, ros::Publisher> wrench_publishers_;  ///< by topic, per anchor and grasp
   ros::Timer timer_;
   std::unique_ptr<AnchorHandles> handles_;
   std::unique_ptr<ReconfigureServer<SimConfig>> sim_reconfigure_;
@@ -142,6 +156,8 @@ private:
   bool paused_ = false;
   StepStatistics statistics_;
   double max_strain_ = 0.0;       ///< [-] largest |l - L| / L of a spring or constraint, last tick
+  std::vector<GraspSlip> slips_;  ///< grasps that slipped since the last state message
+  double force_scale_ = 0.02;     ///< ~force_scale [m/N]: length of the force arrows on ~force_markers
 };
 
 }  // namespace soft_body_sim
