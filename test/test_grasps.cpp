@@ -151,11 +151,7 @@ TEST(GraspForce, AGripperHoldingARopeAsideCarriesItsWeightAndItsMoment)
   World world = buildWorld(scene);
   const Vec3 origin(0.05, 0.0, 1.0);
   ASSERT_EQ(world.grasp("gripper", "rope", poseAt(origin), 0.12), 3u);
-  int steps = 0;
-  do
-    world.step();
-  while (++steps < 40000 && world.state().velocity.colwise().norm().maxCoeff() > 1e-8);
-  ASSERT_LT(steps, 40000) << "the rope did not come to rest";
+  ASSERT_TRUE(settle(world, 1e-8, 40000)) << "the rope did not come to rest";
   const double weight = 0.1 * kGravity;
   const Wrench wrench = world.graspWrenches().at(0);
   EXPECT_TRUE(expectNear(wrench.force, Vec3(0, 0, -weight), 1e-3 * weight));

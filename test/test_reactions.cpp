@@ -16,18 +16,6 @@ namespace soft_body_sim::test
 {
 namespace
 {
-/// Steps until every node is slower than `speed` [m/s]; false if that takes more than `max_steps`.
-bool settle(World& world, double speed, long max_steps)
-{
-  for (long n = 0; n < max_steps; ++n)
-  {
-    world.step();
-    if (world.state().velocity.colwise().norm().maxCoeff() < speed)
-      return true;
-  }
-  return false;
-}
-
 /// A scene of one rope of 21 nodes, 1 m and 0.1 kg, laid at rest along `path`, springs of 200 N/m with
 /// dashpots, under gravity with air drag so that it comes to rest; `pinned` nodes are anchors named "end0",
 /// "end1", ...

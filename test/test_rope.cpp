@@ -20,18 +20,6 @@ namespace
 {
 std::string scenePath(const std::string& name) { return std::string(SOURCE_DIR) + "/config/scenes/" + name; }
 
-/// Steps until every node is slower than `speed` [m/s]; false if `max_steps` pass first.
-bool settle(World& world, double speed, long max_steps)
-{
-  for (long n = 0; n < max_steps; ++n)
-  {
-    world.step();
-    if (world.state().velocity.colwise().norm().maxCoeff() < speed)
-      return true;
-  }
-  return false;
-}
-
 // --- the builder --------------------------------------------------------------------------------
 
 TEST(RopeBuilder, EqualMassNodesOnTheSegmentAndSpringsAtRest)

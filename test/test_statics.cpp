@@ -12,19 +12,6 @@ namespace soft_body_sim::test
 {
 namespace
 {
-/// Runs until the speed of every node is below `speed` [m/s] or `max_steps` pass; returns the steps run.
-long settle(World& world, double speed, long max_steps)
-{
-  long n = 0;
-  for (; n < max_steps; ++n)
-  {
-    world.step();
-    if (world.state().velocity.colwise().norm().maxCoeff() < speed)
-      break;
-  }
-  return n;
-}
-
 // A chain of N nodes hangs from a pinned top node. Spring j (between nodes j-1 and j) carries the weight
 // of the N - j nodes below it, so it is stretched by (N - j) m g / k and node j sits at
 //   z_j = -sum_{i=1..j} (L + (N - i) m g / k).

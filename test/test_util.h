@@ -44,6 +44,18 @@ inline std::vector<IntegratorType> stableIntegrators(const SceneDef& scene)
   return stable;
 }
 
+/// Steps until every node is slower than `speed` [m/s]; false if `max_steps` pass first.
+inline bool settle(World& world, double speed, long max_steps)
+{
+  for (long n = 0; n < max_steps; ++n)
+  {
+    world.step();
+    if (world.state().velocity.colwise().norm().maxCoeff() < speed)
+      return true;
+  }
+  return false;
+}
+
 inline bool allFinite(const State& state)
 {
   return state.position.allFinite() && state.velocity.allFinite();
