@@ -6,6 +6,12 @@
 
 namespace soft_body_sim
 {
+namespace
+{
+/// `pose` with its orientation normalised (slerp and the offsets' rotation assume a unit quaternion).
+RigidPose unit(const RigidPose& pose) { return RigidPose{ pose.position, pose.orientation.normalized() }; }
+}  // namespace
+
 std::string GraspSlip::describe() const
 {
   char text[128];
@@ -27,8 +33,8 @@ std::size_t GraspSet::grasp(Model& model, const State& state, const std::string&
     ++b;
   if (b == model.bodies.size())
     throw std::invalid_argument("there is no body '" + body + "'");
-  GraspedNodes g{ name, b, {}, {}, pose, max_force };
-  const Eigen::Quaterniond to_frame = pose.orientation.conjugate();
+  GraspedNodes g{ name, b, {}, {}, unit(pose), max_force };
+  const Eigen::Quaterniond to_frame = g.pose.orientation.conjugate();
   const BodyRange& range = model.bodies[b];
   for (int i = range.first; i < range.first + range.count; ++i)
     if (model.isFree(i) && (state.position.col(i) - pose.position).norm() <= radius)
@@ -66,7 +72,7 @@ bool GraspSet::setGoal(const std::string& name, const RigidPose& pose)
   const std::size_t k = find(name);
   if (k == grasps_.size())
     return false;
-  goals_[k] = pose;
+  goals_[k] = unit(pose);
   return true;
 }
 
@@ -83,7 +89,8 @@ void GraspSet::goalsFromPaths(double t)
 {
   for (std::size_t k = 0; k < grasps_.size(); ++k)
     if (paths_[k] && !goals_[k])
-      goals_[k] = paths_[k](t);
+      if (const std::optional<RigidPose> pose = paths_[k](t))
+        goals_[k] = unit(*pose);
 }
 
 std::size_t GraspSet::find(const std::string& name) const
