@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include "catenary.h"
+#include "soft_body_sim/core/bodies/jelly.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/integrator_groups.h"
 #include "test_util.h"
@@ -91,6 +92,35 @@ TEST(AnchorForce, AChainsAnchorsTakeTheCatenarysHorizontalTensionAndItsWeight)
   }
 }
 
+TEST(AnchorForce, AJellyHangingFromItsTopCornersHasThemCarryItsWeight)
+{
+  // A 3 x 3 jelly of 1 kg hangs from its top corners: its springs and the gas in its cells (which pushes
+  // on the corners too) hold them, and at rest the two carry its whole weight, half each by symmetry.
+  JellyDef jelly;
+  jelly.nx = jelly.ny = 3;
+  SceneDef scene = oneBodyScene(IntegratorType::Xpbd, 2e-3);
+  scene.physics.gravity = Vec3(0, 0, -kGravity);
+  scene.physics.drag = 2.0;
+  scene.bodies[0] = buildJelly("jelly", jelly);
+  for (NodeDef& node : scene.bodies[0].nodes)
+    node.mass = 1.0 / 16.0;
+  scene.bodies[0].nodes[0].pinned = scene.bodies[0].nodes[3].pinned = true;
+  scene.bodies[0].anchors = { AnchorDef("left", 0), AnchorDef("right", 3) };
+  const double weight = kGravity;
+  for (const IntegratorType integrator : stableIntegrators(scene))
+  {
+    scene.physics.integrator = integrator;
+    World world = buildWorld(scene);
+    ASSERT_TRUE(settle(world, 1e-7, 200000)) << integratorName(integrator);
+    const std::vector<Wrench> wrenches = world.anchorWrenches();
+    ASSERT_EQ(wrenches.size(), 2u);
+    EXPECT_NEAR(wrenches[0].force.z() + wrenches[1].force.z(), -weight, 1e-3 * weight) << integratorName(integrator);
+    EXPECT_NEAR(wrenches[0].force.z(), -weight / 2, 1e-3 * weight) << integratorName(integrator);
+    // The cells do push on the corners: without them the springs alone would not balance the weight.
+    EXPECT_GT(world.internalForces().pressure.cwiseAbs().maxCoeff(), 1.0) << integratorName(integrator);
+  }
+}
+
 TEST(LinkTension, APendulumsLinkCarriesThreeTimesItsWeightAtTheBottom)
 {
   // A mass m on an inextensible link of length L, released from rest with the link horizontal: at the
@@ -153,11 +183,11 @@ TEST(LinkTension, EachBodysLinksTakeTheirTensionsFromTheIntegratorSteppingIt)
   groups.switchBody(1, IntegratorType::Xpbd);
   groups.prepare(world.model());
   groups.step(world.model(), state, 1e-3, 1, nullptr);
-  Eigen::VectorXd tension;
-  groups.linkTensions(world.model(), state, tension);
-  ASSERT_EQ(tension.size(), 2);
-  EXPECT_NEAR(tension[0], 0.3 * kGravity, 1e-9);
-  EXPECT_NEAR(tension[1], 0.2 * kGravity, 1e-9);
+  InternalForces forces;
+  groups.internalForces(world.model(), state, forces);
+  ASSERT_EQ(forces.tension.size(), 2);
+  EXPECT_NEAR(forces.tension[0], 0.3 * kGravity, 1e-9);
+  EXPECT_NEAR(forces.tension[1], 0.2 * kGravity, 1e-9);
 }
 
 }  // namespace

@@ -56,17 +56,21 @@ const std::vector<std::string>& integratorNames()
 
 std::unique_ptr<Integrator> makeIntegrator(IntegratorType type) { return entry(type).make(); }
 
-void springLawTensions(const Model& model, const State& state, Eigen::VectorXd& tension)
+void stateInternalForces(const Model& model, const State& state, InternalForces& forces)
 {
-  tension.setZero(static_cast<Eigen::Index>(model.springs.size() + model.constraints.size()));
+  forces.tension.setZero(static_cast<Eigen::Index>(model.springs.size() + model.constraints.size()));
   for (std::size_t k = 0; k < model.springs.size(); ++k)
   {
     const Spring& s = model.springs[k];
     Vec3 u;
     double length;
     if (springAxis(state.position, s.a, s.b, u, length))
-      tension[static_cast<Eigen::Index>(k)] = springTension(s, u, length, state.velocity);
+      forces.tension[static_cast<Eigen::Index>(k)] = springTension(s, u, length, state.velocity);
   }
+  forces.pressure.resize(static_cast<Eigen::Index>(model.cells.size()));
+  for (std::size_t k = 0; k < model.cells.size(); ++k)
+    forces.pressure[static_cast<Eigen::Index>(k)] =
+        cellGas(model.cells[k], cellArea(model.cells[k], state.position)).pressure;
 }
 
 }  // namespace soft_body_sim

@@ -41,20 +41,23 @@ void IntegratorGroups::step(const Model& model, State& state, double h, int iter
     group.integrator->stepWithContacts(group.model, state, h, iterations, contacts);
 }
 
-void IntegratorGroups::linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const
+void IntegratorGroups::internalForces(const Model& model, const State& state, InternalForces& forces) const
 {
   if (groups_.empty())
   {
-    integrator_->linkTensions(model, state, tension);
+    integrator_->internalForces(model, state, forces);
     return;
   }
-  tension.setZero(static_cast<Eigen::Index>(model.springs.size() + model.constraints.size()));
-  Eigen::VectorXd mine;
+  forces.tension.setZero(static_cast<Eigen::Index>(model.springs.size() + model.constraints.size()));
+  forces.pressure.setZero(static_cast<Eigen::Index>(model.cells.size()));
+  InternalForces mine;
   for (const Group& group : groups_)
   {
-    group.integrator->linkTensions(group.model, state, mine);
+    group.integrator->internalForces(group.model, state, mine);
     for (std::size_t k = 0; k < group.links.size(); ++k)
-      tension[static_cast<Eigen::Index>(group.links[k])] = mine[static_cast<Eigen::Index>(k)];
+      forces.tension[static_cast<Eigen::Index>(group.links[k])] = mine.tension[static_cast<Eigen::Index>(k)];
+    for (std::size_t k = 0; k < group.cells.size(); ++k)
+      forces.pressure[static_cast<Eigen::Index>(group.cells[k])] = mine.pressure[static_cast<Eigen::Index>(k)];
   }
 }
 
@@ -95,7 +98,7 @@ void IntegratorGroups::rebuild(const Model& model)
   for (const IntegratorType type : types)
   {
     const auto mine = [&](int node) { return node_type[static_cast<std::size_t>(node)] == type; };
-    Group group{ type, model, makeIntegrator(type), {} };
+    Group group{ type, model, makeIntegrator(type), {}, {} };
     Model& m = group.model;
     for (int i = 0; i < m.nodeCount(); ++i)
       if (!mine(i))
@@ -117,9 +120,12 @@ void IntegratorGroups::rebuild(const Model& model)
         group.links.push_back(model.springs.size() + k);
       }
     m.cells.clear();
-    std::copy_if(model.cells.begin(), model.cells.end(), std::back_inserter(m.cells), [&](const PressureCell& c) {
-      return std::any_of(std::begin(c.nodes), std::end(c.nodes), mine);
-    });
+    for (std::size_t k = 0; k < model.cells.size(); ++k)
+      if (std::any_of(std::begin(model.cells[k].nodes), std::end(model.cells[k].nodes), mine))
+      {
+        m.cells.push_back(model.cells[k]);
+        group.cells.push_back(k);
+      }
     m.colliders = Colliders{};
     m.contact_segments.clear();
     groups_.push_back(std::move(group));

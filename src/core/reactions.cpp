@@ -4,8 +4,9 @@
 
 namespace soft_body_sim
 {
-void linkPulls(const Model& model, const NodeArray& x, const Eigen::VectorXd& tension, NodeArray& pull)
+void internalPulls(const Model& model, const NodeArray& x, const InternalForces& forces, NodeArray& pull)
 {
+  const Eigen::VectorXd& tension = forces.tension;
   pull.setZero(3, model.nodeCount());
   const auto add = [&](int a, int b, double t) {
     Vec3 u;
@@ -20,6 +21,13 @@ void linkPulls(const Model& model, const NodeArray& x, const Eigen::VectorXd& te
   for (std::size_t k = 0; k < model.constraints.size(); ++k)
     add(model.constraints[k].a, model.constraints[k].b,
         tension[static_cast<Eigen::Index>(model.springs.size() + k)]);
+  Vec3 gradient[4];
+  for (std::size_t k = 0; k < model.cells.size(); ++k)
+  {
+    cellArea(model.cells[k], x, gradient);
+    for (int corner = 0; corner < 4; ++corner)
+      pull.col(model.cells[k].nodes[corner]) += forces.pressure[static_cast<Eigen::Index>(k)] * gradient[corner];
+  }
 }
 
 Wrench holdingWrench(const Model& model, const NodeArray& x, const NodeArray& pull, const std::vector<int>& nodes,

@@ -283,17 +283,17 @@ bool World::detach(int anchor)
   return true;
 }
 
-Eigen::VectorXd World::linkTensions() const
+InternalForces World::internalForces() const
 {
-  Eigen::VectorXd tension;
-  integrators_.linkTensions(model_, state_, tension);
-  return tension;
+  InternalForces forces;
+  integrators_.internalForces(model_, state_, forces);
+  return forces;
 }
 
 NodeArray World::pulls() const
 {
   NodeArray pull;
-  linkPulls(model_, state_.position, linkTensions(), pull);
+  internalPulls(model_, state_.position, internalForces(), pull);
   return pull;
 }
 

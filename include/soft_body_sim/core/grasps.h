@@ -76,7 +76,7 @@ public:
   void land();
 
   /// Per grasp, the wrench its body exerts on it (holdingWrench), torque about its frame's origin; `pull`
-  /// is linkPulls'.
+  /// is internalPulls'.
   std::vector<Wrench> wrenches(const Model& model, const NodeArray& x, const NodeArray& pull) const;
   /// True if some grasp has a force limit (its wrench is then needed every step).
   bool limited() const;

@@ -47,6 +47,13 @@ public:
   virtual bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const = 0;
 };
 
+/// The forces inside the bodies in the last sub-step, as an integrator's solve had them.
+struct InternalForces
+{
+  Eigen::VectorXd tension;   ///< [N] per spring, then per distance constraint (model order), > 0 stretched
+  Eigen::VectorXd pressure;  ///< [N/m] per pressure cell (PressureCell), > 0 pushing its outline out
+};
+
 class Integrator
 {
 public:
@@ -61,12 +68,12 @@ public:
   {
     step(model, state, h, iterations);
   }
-  /// Each link's tension [N] in the last sub-step, > 0 when stretched (it pulls each end toward the other
-  /// with that force): `tension` gets the model's springs, then its distance constraints, in model order.
-  /// The force-based schemes take the spring law at `state` and, for constraints, their constraint pass's
-  /// multipliers as forces -lambda / h^2; xpbd takes its multipliers for both. Before the first step: the
-  /// spring law, and 0 for constraints.
-  virtual void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const = 0;
+  /// The forces inside the bodies in the last sub-step: each link's tension (it pulls each end toward the
+  /// other with that force) and each cell's gas pressure. The force-based schemes take the spring and gas
+  /// laws at `state` and, for constraints, their constraint pass's multipliers as forces -lambda / h^2;
+  /// xpbd takes its multipliers for all three. Before the first step: the laws at `state`, and 0 for
+  /// constraints.
+  virtual void internalForces(const Model& model, const State& state, InternalForces& forces) const = 0;
   /// The state was changed from outside the integrator (an anchor or controller moved its nodes, a
   /// plane contact changed a velocity, a node was set): drop anything cached from the old state.
   virtual void invalidate() {}

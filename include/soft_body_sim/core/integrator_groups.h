@@ -34,9 +34,9 @@ public:
   /// none).
   void step(const Model& model, State& state, double h, int iterations, const ContactQuery* contacts);
 
-  /// Each link's tension [N] in the last sub-step, by the integrator stepping it (Integrator::linkTensions);
-  /// a link between two groups by the last of them.
-  void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const;
+  /// The forces inside the bodies in the last sub-step, each link's and cell's by the integrator stepping it
+  /// (Integrator::internalForces); one between two groups by the last of them.
+  void internalForces(const Model& model, const State& state, InternalForces& forces) const;
 
   /// The state was changed from outside the integrators: they drop what they cached from it.
   void invalidate();
@@ -50,6 +50,7 @@ private:
     Model model;
     std::unique_ptr<Integrator> integrator;
     std::vector<std::size_t> links;  ///< per link of `model` (springs, then constraints): its index in the scene's
+    std::vector<std::size_t> cells;  ///< per cell of `model`: its index in the scene's
   };
 
   void rebuild(const Model& model);

@@ -144,9 +144,11 @@ public:
   std::vector<GraspSlip> takeGraspSlips() { return std::exchange(slips_, {}); }
 
   // --- forces on what holds the bodies (reactions.h), worked out when asked ------------------------
+  /// The forces inside the bodies in the last sub-step (Integrator::internalForces).
+  InternalForces internalForces() const;
   /// Each link's tension [N] in the last sub-step, > 0 stretched: springs, then constraints, in model
-  /// order (Integrator::linkTensions).
-  Eigen::VectorXd linkTensions() const;
+  /// order (internalForces().tension).
+  Eigen::VectorXd linkTensions() const { return internalForces().tension; }
   /// Per anchor of model().anchors, the wrench its body exerts on it, torque about its node.
   std::vector<Wrench> anchorWrenches() const;
   /// Per grasp of grasps(), the wrench its body exerts on it, torque about its frame's origin.
@@ -186,7 +188,7 @@ private:
 
   /// Applies the guard's policy to body `body` and says what it did.
   std::string treatDiverged(std::size_t body);
-  /// Per node, its links' pull (linkPulls).
+  /// Per node, the internal forces on it (internalPulls).
   NodeArray pulls() const;
   /// The model's parameters or pinning changed: the integrators drop their caches.
   void modelChanged() { integrators_.modelChanged(); }

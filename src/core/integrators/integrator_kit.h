@@ -95,18 +95,18 @@ private:
   double h_ = 0.0;  ///< [s] of the last projection; 0 = none yet
 };
 
-/// The springs' tensions by the spring law at `state`, then 0 for each constraint (see
-/// Integrator::linkTensions).
-void springLawTensions(const Model& model, const State& state, Eigen::VectorXd& tension);
+/// The springs' tensions by the spring law and the cells' pressures by the gas law at `state`, and 0 for
+/// each constraint (see Integrator::internalForces).
+void stateInternalForces(const Model& model, const State& state, InternalForces& forces);
 
 /// A force-based scheme: springs and dashpots as forces, constraints by its ConstraintPass.
 class ForceBasedIntegrator : public Integrator
 {
 public:
-  void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const override
+  void internalForces(const Model& model, const State& state, InternalForces& forces) const override
   {
-    springLawTensions(model, state, tension);
-    constraints_.tensions(model, tension.tail(static_cast<Eigen::Index>(model.constraints.size())));
+    stateInternalForces(model, state, forces);
+    constraints_.tensions(model, forces.tension.tail(static_cast<Eigen::Index>(model.constraints.size())));
   }
 
 protected:

@@ -68,16 +68,18 @@ public:
     postSolve(model, state, h);
   }
 
-  void linkTensions(const Model& model, const State& state, Eigen::VectorXd& tension) const override
+  void internalForces(const Model& model, const State& state, InternalForces& forces) const override
   {
-    springLawTensions(model, state, tension);
-    if (solved_h_ == 0.0 || lambda_.size() != tension.size())
+    stateInternalForces(model, state, forces);
+    if (solved_h_ == 0.0 || lambda_.size() != forces.tension.size() || cell_lambda_.size() != forces.pressure.size())
       return;
     // Row order_[k]'s multiplier moved its ends by w lambda u: the displacement h^2 w F of a force
-    // F = lambda u / h^2 on end a, a tension of -lambda / h^2.
+    // F = lambda u / h^2 on end a, a tension of -lambda / h^2. A cell's moved its corners by w lambda dA/dx,
+    // the displacement of the force p dA/dx of a pressure p = lambda / h^2 (solveCell).
     const double inverse_h2 = 1.0 / (solved_h_ * solved_h_);
     for (std::size_t k = 0; k < order_.size(); ++k)
-      tension[order_[k]] = -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2;
+      forces.tension[order_[k]] = -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2;
+    forces.pressure = cell_lambda_ * inverse_h2;
   }
 
   /// The rows hold only the model's parameters and h, so a change of state (invalidate()) keeps them;
