@@ -187,8 +187,11 @@ TEST_P(StepAllocation, NoStepAllocatesAfterTheFirst)
   World world = buildWorld(everyFeatureScene(GetParam()));
   const int left = *world.findAnchor("rope", "left");
   const int corner = *world.findAnchor("cloth", "corner");
+  // A gripper holds the cloth's far corner and turns it (grasps.h).
+  const Vec3 far_corner = world.state().position.col(world.model().bodies[2].first + 29);
+  world.grasp("hand", "cloth", RigidPose{ far_corner, Eigen::Quaterniond::Identity() }, 0.05);
   world.step();  // the first step may size the integrator's scratch arrays
-  // Moving anchors invalidate the integrator every sub-step; the jelly lands on the floor early on, so
+  // Moving anchors and grasps invalidate the integrator every sub-step; the jelly lands on the floor early on, so
   // contacts invalidate it too.
   const long allocations = allocationsOf([&] {
     for (int n = 0; n < 400; ++n)
@@ -198,6 +201,8 @@ TEST_P(StepAllocation, NoStepAllocatesAfterTheFirst)
         world.moveAnchor(left, Vec3(-2.0, 0.001 * n, 1.0));
         world.moveAnchor(corner, Vec3(0.0, -0.001 * n, 1.0));
         world.setTarget("creature", Vec3(3.0 + 0.001 * n, 0.2, 1.0));
+        world.moveGrasp("hand", RigidPose{ far_corner + Vec3(0.0, 0.0, 0.001 * n),
+                                           Eigen::Quaterniond(Eigen::AngleAxisd(0.002 * n, Vec3::UnitX())) });
       }
       world.step();
     }
