@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include <ros/names.h>
 #include <std_msgs/Time.h>
 
 #include "soft_body_sim/SimState.h"
@@ -223,6 +224,14 @@ void SimNode::publishWrenches(const std::vector<Holder>& holders, const ros::Tim
   for (const Holder& holder : holders)
   {
     const std::string topic = world_->model().bodies[holder.body].name + "/" + holder.name + "/wrench";
+    std::string why;
+    if (!ros::names::validate(topic, why))
+    {
+      // A tf frame may be named what a topic may not (an ~attach or ~grasp frame "hand-1").
+      ROS_WARN_THROTTLE(60.0, "%s: no wrench topic for '%s': %s (its wrench is in ~state)", name_.c_str(),
+                        holder.name.c_str(), why.c_str());
+      continue;
+    }
     auto found = wrench_publishers_.find(topic);
     ros::Publisher publisher = found != wrench_publishers_.end()
                                    ? found->second

@@ -1,6 +1,7 @@
 // SimNode's inputs: pose topics and rviz handles scheduled by stamp, anchors following tf frames, and
-// grasping with ~attach / ~detach (one node) and ~grasp / ~release (a gripper's width). Whatever arrives is checked before it reaches the world: a refused
-// input or request is named in a (throttled) warning and changes nothing.
+// grasping with ~attach / ~detach (one node) and ~grasp / ~release (a gripper's width). Whatever arrives
+// is checked before it reaches the world: a refused input or request is named in a (throttled) warning
+// and changes nothing.
 #include <algorithm>
 #include <cctype>
 #include <cmath>

@@ -160,6 +160,20 @@ class GraspTest(NodeTestCase):
         self.assertEqual(list(self.body().holders), ["top"])
         self.assertFalse(self.release(frame="weak_hand").success)
 
+    def test_a_frame_whose_name_is_no_ros_name_grasps_without_a_wrench_topic(self):
+        # tf frames may hold characters that ROS names may not: the grasp holds, its wrench is in ~state.
+        self.wait_for_rest()
+        self.set_frame("hand-2", lambda t: ((0.0, 0.0, rest_z(10)), (0.0, 0.0, 0.0, 1.0)))
+        rospy.sleep(0.2)  # the frame reaches tf
+        response = self.grasp(frame="hand-2", body="rope", radius=0.02, max_force=0.0)
+        self.assertTrue(response.success, response.message)
+        self.state.next(5)
+        body = self.body()
+        self.assertEqual(list(body.holders), ["top", "hand-2"])
+        self.assertTrue(math.isfinite(body.wrenches[1].force.z))
+        self.assertTrue(self.release(frame="hand-2").success)
+        self.state.next(2)
+
     def test_bad_grasp_requests_are_refused_with_their_reason(self):
         self.set_frame("far_hand", lambda t: ((5.0, 5.0, 5.0), (0.0, 0.0, 0.0, 1.0)))
         self.assertTrue(wait_for(lambda: rospy.Time.now().to_sec() > 0.0, 5.0))
