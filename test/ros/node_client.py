@@ -1,10 +1,13 @@
 """Helpers shared by the Python rostests: wait for a condition while rospy delivers messages, keep
-the latest state of a simulator, run the standard command-line clients."""
+the latest state of a simulator, broadcast tf frames, run the standard command-line clients."""
 import subprocess
+import threading
 import time
 import unittest
 
 import rospy
+import tf2_ros
+from geometry_msgs.msg import TransformStamped
 from soft_body_sim.msg import SimState
 
 
@@ -25,6 +28,44 @@ def run(*command, timeout=30):
     if result.returncode != 0:
         raise AssertionError(f"{' '.join(command)} exited {result.returncode}: {result.stderr.strip()}")
     return result.stdout
+
+
+class FrameBroadcaster:
+    """Broadcasts tf frames, children of `parent`, every `period` seconds: each given by a function of the
+    ROS time [s] that returns its (position, quaternion (x, y, z, w))."""
+
+    def __init__(self, parent="world", period=0.02):
+        self.parent = parent
+        self.frames = {}
+        self.lock = threading.Lock()
+        self.broadcaster = tf2_ros.TransformBroadcaster()
+        self.timer = rospy.Timer(rospy.Duration(period), self._broadcast)
+
+    def set(self, child, pose):
+        with self.lock:
+            self.frames[child] = pose
+
+    def set_position(self, child, position):
+        """A frame standing still at `position`, unrotated."""
+        self.set(child, lambda _t: (position, (0.0, 0.0, 0.0, 1.0)))
+
+    def _broadcast(self, _event):
+        now = rospy.Time.now()
+        with self.lock:
+            frames = dict(self.frames)
+        transforms = []
+        for child, pose in frames.items():
+            (x, y, z), (qx, qy, qz, qw) = pose(now.to_sec())
+            t = TransformStamped()
+            t.header.stamp = now
+            t.header.frame_id = self.parent
+            t.child_frame_id = child
+            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
+            t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z = qx, qy, qz
+            t.transform.rotation.w = qw
+            transforms.append(t)
+        if transforms:
+            self.broadcaster.sendTransform(transforms)
 
 
 class StateWatcher:

@@ -4,15 +4,13 @@ topic and the state's holders, wrenches and tensions against the hanging rope's 
 nodes within its radius in a turning tf frame, ~release lets go, a grasp above its max_force slips and
 says so; bad requests are refused with their reason."""
 import math
-import threading
 
 import rospy
 import rostest
-import tf2_ros
-from geometry_msgs.msg import TransformStamped, WrenchStamped
+from geometry_msgs.msg import WrenchStamped
 from rosgraph_msgs.msg import Log
 
-from node_client import NodeTestCase, StateWatcher, wait_for
+from node_client import FrameBroadcaster, NodeTestCase, StateWatcher, wait_for
 from soft_body_sim.srv import Detach, Grasp
 
 NODE = "/soft_body_sim"
@@ -31,35 +29,13 @@ class GraspTest(NodeTestCase):
     def setUpClass(cls):
         rospy.init_node("test_grasp")
         cls.state = StateWatcher()
-        cls.frames = {}  # child frame -> function of time giving (position, quaternion x y z w)
-        cls.lock = threading.Lock()
-        cls.broadcaster = tf2_ros.TransformBroadcaster()
-        cls.timer = rospy.Timer(rospy.Duration(0.02), cls._broadcast)
+        cls.frames = FrameBroadcaster()
         cls.log = []
         rospy.Subscriber("/rosout", Log, cls.log.append, queue_size=100)
         rospy.wait_for_service(NODE + "/grasp", 20.0)
         cls.grasp = rospy.ServiceProxy(NODE + "/grasp", Grasp)
         cls.release = rospy.ServiceProxy(NODE + "/release", Detach)
         cls.state.next(1, 20.0)
-
-    @classmethod
-    def _broadcast(cls, _event):
-        now = rospy.Time.now()
-        with cls.lock:
-            frames = dict(cls.frames)
-        transforms = []
-        for child, pose in frames.items():
-            (x, y, z), (qx, qy, qz, qw) = pose(now.to_sec())
-            t = TransformStamped()
-            t.header.stamp = now
-            t.header.frame_id = "world"
-            t.child_frame_id = child
-            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
-            t.transform.rotation.x, t.transform.rotation.y, t.transform.rotation.z = qx, qy, qz
-            t.transform.rotation.w = qw
-            transforms.append(t)
-        if transforms:
-            cls.broadcaster.sendTransform(transforms)
 
     def wait_for_rest(self):
         """The rope starts straight at its rest length, and swings after a test lets it go: it settles
@@ -69,8 +45,7 @@ class GraspTest(NodeTestCase):
                         "the rope did not come to rest")
 
     def set_frame(self, child, pose):
-        with self.lock:
-            self.frames[child] = pose
+        self.frames.set(child, pose)
 
     def body(self):
         return self.state.latest.bodies[0]

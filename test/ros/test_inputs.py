@@ -5,18 +5,16 @@ a node at another frame; bad requests and bad input parameters are refused with 
 import math
 import os
 import subprocess
-import threading
 
 import roslib.packages
 import rospy
 import rostest
-import tf2_ros
-from geometry_msgs.msg import PoseStamped, TransformStamped
+from geometry_msgs.msg import PoseStamped
 from rosgraph_msgs.msg import Log
 from std_srvs.srv import SetBool
 from visualization_msgs.msg import InteractiveMarkerFeedback, InteractiveMarkerInit, MarkerArray
 
-from node_client import NodeTestCase, StateWatcher, wait_for
+from node_client import FrameBroadcaster, NodeTestCase, StateWatcher, wait_for
 from soft_body_sim.srv import Attach, Detach
 
 NODE = "/soft_body_sim"
@@ -36,10 +34,8 @@ class InputsTest(NodeTestCase):
     def setUpClass(cls):
         rospy.init_node("test_inputs")
         cls.state = StateWatcher()
-        cls.frames = {}  # child frame -> fixed position; gripper_link moves on its circle
-        cls.lock = threading.Lock()
-        cls.broadcaster = tf2_ros.TransformBroadcaster()
-        cls.timer = rospy.Timer(rospy.Duration(0.02), cls._broadcast)
+        cls.frames = FrameBroadcaster()  # gripper_link moves on its circle; others stand where a test puts them
+        cls.frames.set("gripper_link", lambda t: (gripper_position(t), (0.0, 0.0, 0.0, 1.0)))
         cls.handles = None
         rospy.Subscriber(NODE + "/handles/update_full", InteractiveMarkerInit,
                          lambda m: setattr(cls, "handles", m), queue_size=1)
@@ -53,26 +49,8 @@ class InputsTest(NodeTestCase):
         cls.detach = rospy.ServiceProxy(NODE + "/detach", Detach)
         cls.state.next(1, 20.0)
 
-    @classmethod
-    def _broadcast(cls, _event):
-        now = rospy.Time.now()
-        with cls.lock:
-            frames = dict(cls.frames)
-        frames["gripper_link"] = gripper_position(now.to_sec())
-        transforms = []
-        for child, (x, y, z) in frames.items():
-            t = TransformStamped()
-            t.header.stamp = now
-            t.header.frame_id = "world"
-            t.child_frame_id = child
-            t.transform.translation.x, t.transform.translation.y, t.transform.translation.z = x, y, z
-            t.transform.rotation.w = 1.0
-            transforms.append(t)
-        cls.broadcaster.sendTransform(transforms)
-
     def set_frame(self, child, position):
-        with self.lock:
-            self.frames[child] = position
+        self.frames.set_position(child, position)
 
     def test_an_anchor_follows_its_tf_frame(self):
         # Each step's end asks tf for the frame at that instant (the latest transform when the step is
