@@ -67,6 +67,12 @@ std::pair<double, double> contactParameters(const Vec3& p0, const Vec3& d1, cons
 Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::pair<int, int>& to, double& p,
                 double& q)
 {
+  if (from.first == from.second && to.first == to.second)
+  {
+    // Two balls (a cloth's or jelly's nodes): the general case's answer, without its work.
+    p = q = 0.0;
+    return x.col(from.first) - x.col(to.first);
+  }
   const Vec3 xa = x.col(from.first), xc = x.col(to.first);
   const Vec3 along_from = x.col(from.second) - xa, along_to = x.col(to.second) - xc;
   std::tie(p, q) = contactParameters(xa, along_from, xc, along_to);
