@@ -7,6 +7,7 @@
 
 #include <Eigen/LU>
 
+#include "block_tridiagonal_solver.h"
 #include "integrator_kit.h"
 #include "sparse_block_solver.h"
 #include "soft_body_sim/core/forces.h"
@@ -21,10 +22,11 @@ using Matrix3 = Eigen::Matrix3d;
 /// solved by Newton's method as in Baraff & Witkin 1998 ("Large steps in cloth simulation"):
 /// each iteration linearises f about (x_lin, v_k) and solves
 ///   (M - h D - h^2 K) dv = h f(x_lin, v_k) + h K (x_n + h v_k - x_lin) - M (v_k - v_n)
-/// with K = df/dx, D = df/dv, directly by a sparse LDL^T factorisation (SparseBlockSolver) or by
-/// preconditioned conjugate gradients, whichever costs less (see solve): on a rope the direct solve is
-/// linear in the nodes, where conjugate gradients needed hundreds of sweeps on a stiff, light chain
-/// (condition number ~ k h^2 / m). The first iteration linearises at
+/// with K = df/dx, D = df/dv, directly (block tridiagonally on chains, BlockTridiagonalSolver, else by a
+/// sparse LDL^T factorisation, SparseBlockSolver) or by preconditioned conjugate gradients, whichever
+/// costs less (see solve): on a rope the direct solve is linear in the nodes, where conjugate gradients
+/// needed hundreds of sweeps on a stiff, light chain (condition number ~ k h^2 / m). The first
+/// iteration linearises at
 /// x_lin = x_n (exactly Baraff & Witkin's step); later ones at x_lin = x_n + h v_k.
 /// K's transverse term k (1 - L/l)(I - u u^T) is dropped when the spring is compressed (Choi & Ko
 /// 2002) so that the matrix stays symmetric positive definite; the damping force's dependence on x is
@@ -41,6 +43,8 @@ using Matrix3 = Eigen::Matrix3d;
 class ImplicitEuler final : public ForceBasedIntegrator
 {
 public:
+  explicit ImplicitEuler(LinearSolve linear_solve) : linear_solve_(linear_solve) {}
+
   void modelChanged() override { analyzed_ = false; }
 
   void step(const Model& model, State& state, double h, int iterations) override
@@ -51,9 +55,11 @@ public:
     for (int k = 0; k < iterations; ++k)
     {
       const NodeArray& v_k = state.velocity;
-      // x_lin and the offset x_n + h v_k - x_lin at which K acts (nonzero only on the first iteration).
-      linear_x_ = start_x_;
+      // x_lin and the offset x_n + h v_k - x_lin at which K acts: x_lin = x_n on the first iteration (the
+      // offset h v_k), x_n + h v_k on the others (no offset).
       offset_.setZero(3, n);
+      if (k > 0)
+        linear_x_ = start_x_;
       for (int i = 0; i < n; ++i)
       {
         if (!model.isFree(i))
@@ -63,7 +69,7 @@ public:
         else
           linear_x_.col(i) += h * v_k.col(i);
       }
-      assemble(model, linear_x_, v_k, h);
+      assemble(model, k == 0 ? start_x_ : linear_x_, v_k, h);
       solve(model);
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
@@ -96,10 +102,6 @@ private:
   void assemble(const Model& model, const NodeArray& x, const NodeArray& v, double h)
   {
     const int n = model.nodeCount();
-    force_.setZero(3, n);
-    accumulateSpringForces(model, x, v, force_);
-    if (!model.cells.empty())
-      accumulatePressureForces(model, x, force_);
     rhs_.resize(3, n);
     diagonal_.resize(static_cast<std::size_t>(n));
     for (int i = 0; i < n; ++i)
@@ -112,8 +114,9 @@ private:
         d.setIdentity();
         continue;
       }
+      // The external forces here; the springs' and cells' below, where their blocks are made.
       const double m = model.mass[i];
-      const Vec3 f = force_.col(i) + m * model.gravity - m * model.drag * v.col(i);
+      const Vec3 f = m * model.gravity - m * model.drag * v.col(i);
       rhs_.col(i) = h * f - m * (v.col(i) - start_v_.col(i));
       d = (m * (1.0 + h * model.drag)) * Matrix3::Identity();
     }
@@ -123,20 +126,29 @@ private:
     {
       const Spring& s = model.springs[k];
       SpringBlock& block = springs_[k];
-      double length;
-      if (!springAxis(x, s.a, s.b, block.u, length))
+      // The spring's axis as springAxis gives it, but with one division where it takes four (u = d / l,
+      // then L / l below): on a rope those divisions were most of the assembly's time.
+      const Vec3 axis = x.col(s.a) - x.col(s.b);
+      const double length = axis.norm();
+      if (length < kMinSpringLength)
       {
         block = SpringBlock{ Vec3::Zero(), 0.0, 0.0 };
         continue;
       }
-      const Matrix3 uu = block.u * block.u.transpose();
-      const double transverse = std::max(0.0, 1.0 - s.rest_length / length);
-      // -df_a/dx_a of the spring (clamped, see above) and -df_a/dv_a of its dashpot.
-      const Matrix3 stiffness = s.stiffness * (uu + transverse * (Matrix3::Identity() - uu));
+      const double inverse_length = 1.0 / length;
+      block.u = axis * inverse_length;
+      // -df_a/dx_a of the spring (clamped, see above) is k ((1 - t) u u^T + t I) with t = (1 - L/l)^+, and
+      // -df_a/dv_a of its dashpot c u u^T: the block h^2 k ((1 - t) u u^T + t I) + h c u u^T = a u u^T + b I.
+      const double transverse = std::max(0.0, 1.0 - s.rest_length * inverse_length);
       block.a = h * h * s.stiffness * (1.0 - transverse) + h * s.damping;
       block.b = h * h * s.stiffness * transverse;
-      const Matrix3 diagonal = h * h * stiffness + h * s.damping * uu;
-      const Vec3 k_offset = -stiffness * (offset_.col(s.a) - offset_.col(s.b));
+      Matrix3 diagonal = block.a * (block.u * block.u.transpose());
+      diagonal.diagonal().array() += block.b;
+      const Vec3 d = offset_.col(s.a) - offset_.col(s.b);
+      const Vec3 k_offset =
+          -s.stiffness * ((1.0 - transverse) * block.u.dot(d) * block.u + transverse * d);
+      // h (f_a + K offset) on end a, its negative on end b (f_a as in accumulateSpringForces).
+      const Vec3 impulse = h * (k_offset - springTension(s, block.u, length, v) * block.u);
       // The preconditioned A's largest eigenvalue over its smallest is about 1 + 4 (h^2 k + h c) / m
       // for the stiffest spring on its lightest free end (a chain's: (m + 4 h^2 k) / m). Springs only:
       // a jelly's stiff cells are left out, which can only make the direct path look dearer than it is.
@@ -146,14 +158,22 @@ private:
       const bool b_free = model.isFree(s.b);
       if (a_free)
       {
-        rhs_.col(s.a) += h * k_offset;
+        rhs_.col(s.a) += impulse;
         diagonal_[static_cast<std::size_t>(s.a)] += diagonal;
       }
       if (b_free)
       {
-        rhs_.col(s.b) -= h * k_offset;
+        rhs_.col(s.b) -= impulse;
         diagonal_[static_cast<std::size_t>(s.b)] += diagonal;
       }
+    }
+    if (!model.cells.empty())
+    {
+      force_.setZero(3, n);
+      accumulatePressureForces(model, x, force_);
+      for (int i = 0; i < n; ++i)
+        if (model.isFree(i))
+          rhs_.col(i) += h * force_.col(i);
     }
     cells_.resize(model.cells.size());
     for (std::size_t k = 0; k < model.cells.size(); ++k)
@@ -305,32 +325,50 @@ private:
           pairs.emplace_back(a, b);
         }
       }
-    factorable_ = solver_.analyze(model.nodeCount(), pairs, kMaxFactorWork);
+    chains_ = linear_solve_ != LinearSolve::Iterative && chain_solver_.analyze(model.nodeCount(), pairs);
+    factorable_ = chains_ || (linear_solve_ != LinearSolve::Iterative &&
+                              solver_.analyze(model.nodeCount(), pairs,
+                                              linear_solve_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork));
     analyzed_ = true;
   }
 
-  /// delta_v_ = A^-1 rhs_: directly, A written from the blocks of assemble into the analysed pattern, or
-  /// by conjugate gradients where they cost less (see kCgSweepsPerRootCondition).
+  /// delta_v_ = A^-1 rhs_: directly, A written from the blocks of assemble into the analysed pattern (block
+  /// tridiagonal where the free nodes form chains, else sparse), or by conjugate gradients where they cost
+  /// less (see kCgSweepsPerRootCondition). A chain's factorisation costs about as much as one CG sweep, so
+  /// a chain always takes the direct path.
   void solve(const Model& model)
   {
     if (!analyzed_)
       analyze(model);
-    const double work_per_entry = solver_.factorWork() / solver_.matrixEntries();
-    if (!factorable_ || work_per_entry > kCgSweepsPerRootCondition * std::sqrt(condition_))
+    if (chains_)
+    {
+      solveDirectly(model, chain_solver_);
+      return;
+    }
+    const bool cheaper_by_cg = linear_solve_ == LinearSolve::Cheaper &&
+                               solver_.factorWork() / solver_.matrixEntries() >
+                                   kCgSweepsPerRootCondition * std::sqrt(condition_);
+    if (!factorable_ || cheaper_by_cg)
     {
       buildPreconditioner(model);
       solveIteratively(model);
       return;
     }
-    solver_.clear();
-    for (int i = 0; i < model.nodeCount(); ++i)
-      solver_.addDiagonal(i, diagonal_[static_cast<std::size_t>(i)]);
+    solveDirectly(model, solver_);
+  }
+
+  /// Writes A into `solver` (BlockTridiagonalSolver or SparseBlockSolver, analysed with the slots of
+  /// analyze), factorises it and solves for delta_v_.
+  template <class Solver>
+  void solveDirectly(const Model& model, Solver& solver)
+  {
+    solver.start(diagonal_);
     for (std::size_t k = 0; k < springs_.size(); ++k)
     {
       const SpringBlock& block = springs_[k];
       if (spring_slot_[k] >= 0)
-        solver_.addOffDiagonal(static_cast<std::size_t>(spring_slot_[k]),
-                               -(block.a * block.u * block.u.transpose() + block.b * Matrix3::Identity()));
+        solver.addOffDiagonal(static_cast<std::size_t>(spring_slot_[k]),
+                              -(block.a * block.u * block.u.transpose() + block.b * Matrix3::Identity()));
     }
     for (std::size_t k = 0; k < cells_.size(); ++k)
     {
@@ -338,17 +376,17 @@ private:
       const PressureCell& cell = model.cells[k];
       for (int c = 0; c < 4; ++c)
         if (model.isFree(cell.nodes[c]))
-          solver_.addDiagonal(cell.nodes[c], block.scale * block.g[c] * block.g[c].transpose());
+          solver.addDiagonal(cell.nodes[c], block.scale * block.g[c] * block.g[c].transpose());
       for (std::size_t p = 0; p < kCellPairs.size(); ++p)
         if (cell_slot_[6 * k + p] >= 0)
-          solver_.addOffDiagonal(static_cast<std::size_t>(cell_slot_[6 * k + p]),
-                                 block.scale * block.g[kCellPairs[p].first] * block.g[kCellPairs[p].second].transpose());
+          solver.addOffDiagonal(static_cast<std::size_t>(cell_slot_[6 * k + p]),
+                                block.scale * block.g[kCellPairs[p].first] * block.g[kCellPairs[p].second].transpose());
     }
     // A is symmetric positive definite by construction (the transverse stiffness of compressed springs
     // and the indefinite part of the gas's Hessian are dropped, see above), unless the state is not
     // finite: then the step is not finite either, and the divergence guard (guard.h) takes it.
-    if (solver_.factorize())
-      solver_.solve(rhs_, delta_v_);
+    if (solver.factorize())
+      solver.solve(rhs_, delta_v_);
     else
       delta_v_.setConstant(3, model.nodeCount(), std::numeric_limits<double>::quiet_NaN());
   }
@@ -366,19 +404,24 @@ private:
   /// No factorisation is even prepared beyond this work per entry (a 100,000-node cloth would need
   /// 0.75 GB for its factor).
   static constexpr double kMaxFactorWork = 2000.0;
+  static constexpr double kAnyWork = std::numeric_limits<double>::infinity();
 
   /// The six pairs of a cell's four corners.
   static constexpr std::array<std::pair<int, int>, 6> kCellPairs{ { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } } };
 
-  NodeArray start_x_, start_v_, linear_x_, offset_, force_;
+  NodeArray start_x_, start_v_, linear_x_, offset_;
+  NodeArray force_;  ///< the cells' pressure forces [N]
   NodeArray rhs_, delta_v_;
   NodeArray residual_, direction_, z_, product_;  ///< conjugate gradients' vectors
   std::vector<Matrix3> diagonal_;        ///< per node: mass and spring blocks of A
   std::vector<Matrix3> preconditioner_;  ///< per node: the inverse of A's full diagonal block (CG)
   std::vector<SpringBlock> springs_;
   std::vector<CellBlock> cells_;
+  const LinearSolve linear_solve_;
   SparseBlockSolver solver_;
-  bool analyzed_ = false;          ///< solver_ holds the pattern of the current model
+  BlockTridiagonalSolver chain_solver_;
+  bool analyzed_ = false;          ///< the solvers hold the pattern of the current model
+  bool chains_ = false;            ///< the free nodes form chains: chain_solver_ solves
   bool factorable_ = true;         ///< the pattern is prepared for the direct solve (see kMaxFactorWork)
   double condition_ = 1.0;         ///< estimate of block-Jacobi preconditioned A's condition number
   std::vector<int> spring_slot_;   ///< per spring: its slot in solver_, or -1 (not coupled)
@@ -386,6 +429,8 @@ private:
 };
 }  // namespace
 
-std::unique_ptr<Integrator> makeImplicitEuler() { return std::make_unique<ImplicitEuler>(); }
+std::unique_ptr<Integrator> makeImplicitEuler() { return makeImplicitEuler(LinearSolve::Cheaper); }
+
+std::unique_ptr<Integrator> makeImplicitEuler(LinearSolve solve) { return std::make_unique<ImplicitEuler>(solve); }
 
 }  // namespace soft_body_sim

@@ -119,6 +119,16 @@ std::unique_ptr<Integrator> makeVerlet();
 std::unique_ptr<Integrator> makeVelocityVerlet();
 std::unique_ptr<Integrator> makeRk4();
 std::unique_ptr<Integrator> makeImplicitEuler();
+/// How implicit_euler solves its linear systems: the cheaper path (its default), or one path always
+/// (Direct: block tridiagonal on chains, else sparse LDL^T at any cost; Iterative: conjugate gradients),
+/// for tests that compare them.
+enum class LinearSolve
+{
+  Cheaper,
+  Direct,
+  Iterative,
+};
+std::unique_ptr<Integrator> makeImplicitEuler(LinearSolve solve);
 std::unique_ptr<Integrator> makeXpbd();
 
 }  // namespace soft_body_sim

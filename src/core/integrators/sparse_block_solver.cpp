@@ -137,7 +137,12 @@ int SparseBlockSolver::entryIndex(int row, int column) const
   return static_cast<int>(found - rows);
 }
 
-void SparseBlockSolver::clear() { std::fill_n(upper_.valuePtr(), upper_.nonZeros(), 0.0); }
+void SparseBlockSolver::start(const std::vector<Matrix3>& diagonal)
+{
+  std::fill_n(upper_.valuePtr(), upper_.nonZeros(), 0.0);
+  for (std::size_t i = 0; i < diagonal.size(); ++i)
+    addDiagonal(static_cast<int>(i), diagonal[i]);
+}
 
 void SparseBlockSolver::addDiagonal(int i, const Matrix3& block)
 {

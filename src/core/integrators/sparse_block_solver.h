@@ -34,8 +34,8 @@ public:
   /// more is allocated: the caller solves otherwise); else it prepares everything and returns true.
   bool analyze(int nodes, const std::vector<std::pair<int, int>>& pairs, double max_work_per_entry);
 
-  /// Sets every value to zero (keeps the pattern).
-  void clear();
+  /// Starts a new matrix (same pattern): A's diagonal block of node i = diagonal[i], every other block 0.
+  void start(const std::vector<Matrix3>& diagonal);
   /// A's diagonal block of node i += block (symmetric).
   void addDiagonal(int i, const Matrix3& block);
   /// A's block (a, b) += block, and (b, a) += block^T, for the pair (a, b) of slot `slot`.
