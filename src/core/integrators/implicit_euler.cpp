@@ -121,22 +121,32 @@ private:
       d = (m * (1.0 + h * model.drag)) * Matrix3::Identity();
     }
     springs_.resize(model.springs.size());
+    length_.resize(model.springs.size());
+    inverse_length_.resize(model.springs.size());
+    // Each spring's axis as springAxis gives it, but with one division where it takes four (u = d / l,
+    // then L / l below), in a loop of its own: short, so that the processor overlaps the square roots and
+    // divisions of many springs (on a rope, they were most of the assembly's time).
+    for (std::size_t k = 0; k < model.springs.size(); ++k)
+    {
+      const Spring& s = model.springs[k];
+      const Vec3 axis = x.col(s.a) - x.col(s.b);
+      const double length = axis.norm();
+      length_[k] = length;
+      inverse_length_[k] = length < kMinSpringLength ? 0.0 : 1.0 / length;
+      springs_[k].u = axis * inverse_length_[k];
+    }
     condition_ = 1.0;
     for (std::size_t k = 0; k < model.springs.size(); ++k)
     {
       const Spring& s = model.springs[k];
       SpringBlock& block = springs_[k];
-      // The spring's axis as springAxis gives it, but with one division where it takes four (u = d / l,
-      // then L / l below): on a rope those divisions were most of the assembly's time.
-      const Vec3 axis = x.col(s.a) - x.col(s.b);
-      const double length = axis.norm();
-      if (length < kMinSpringLength)
+      const double inverse_length = inverse_length_[k];
+      if (inverse_length == 0.0)
       {
-        block = SpringBlock{ Vec3::Zero(), 0.0, 0.0 };
+        block = SpringBlock{ Vec3::Zero(), 0.0, 0.0 };  // coincident ends: no force, no block
         continue;
       }
-      const double inverse_length = 1.0 / length;
-      block.u = axis * inverse_length;
+      const double length = length_[k];
       // -df_a/dx_a of the spring (clamped, see above) is k ((1 - t) u u^T + t I) with t = (1 - L/l)^+, and
       // -df_a/dv_a of its dashpot c u u^T: the block h^2 k ((1 - t) u u^T + t I) + h c u u^T = a u u^T + b I.
       const double transverse = std::max(0.0, 1.0 - s.rest_length * inverse_length);
@@ -416,6 +426,8 @@ private:
   std::vector<Matrix3> diagonal_;        ///< per node: mass and spring blocks of A
   std::vector<Matrix3> preconditioner_;  ///< per node: the inverse of A's full diagonal block (CG)
   std::vector<SpringBlock> springs_;
+  std::vector<double> length_;          ///< per spring: its length [m]
+  std::vector<double> inverse_length_;  ///< per spring: 1 / its length [1/m], 0 if its ends coincide
   std::vector<CellBlock> cells_;
   const LinearSolve linear_solve_;
   SparseBlockSolver solver_;
