@@ -7,7 +7,8 @@
 // (items = spring updates) and how the step cost grows with the node count (scripts/bench fits the
 // log-log slope); BM_ClothSpringForces is the force kernel alone on the 10,000-node cloth.
 // BM_StiffRopeImplicitEuler/<nodes>: implicit Euler's direct solve on a stiff rope, 100 to 100,000 nodes;
-// BM_ClothStepImplicitEulerAt60Hz/<nodes>: implicit Euler on the cloths at dt = 1/60 s, 100 to 10,000.
+// BM_ClothStepImplicitEulerAt60Hz/<nodes>: implicit Euler on the cloths at dt = 1/60 s, 100 to 10,000;
+// BM_ClothLinearSolveAt60Hz/<cheaper|direct|iterative>/<nodes>: the same with each linear solve path.
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
 // capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
@@ -25,6 +26,7 @@
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/forces.h"
+#include "../src/core/integrators/integrator_kit.h"
 #include "large_cloth.h"
 #include "test_meshes.h"
 
@@ -119,6 +121,26 @@ void BM_ClothStepImplicitEulerAt60Hz(benchmark::State& bench)
   }
   bench.counters["nodes"] = world.model().nodeCount();
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(world.model().springs.size()));
+}
+
+/// The same cloths at dt = 1/60 s with implicit_euler's linear solve made one way (the integrator alone,
+/// stepped from the world's model and state): the crossover between the sparse factorisation and
+/// conjugate gradients, and whether the rule (cheaper) picks the faster.
+void BM_ClothLinearSolveAt60Hz(benchmark::State& bench, LinearSolve solve)
+{
+  SceneDef scene = clothScene(static_cast<int>(bench.range(0)), IntegratorType::ImplicitEuler);
+  const World world = buildWorld(scene);
+  const Model& model = world.model();
+  State state = world.state();
+  const std::unique_ptr<Integrator> integrator = makeImplicitEuler(solve);
+  constexpr double h = 1.0 / 60.0;
+  integrator->step(model, state, h, 1);
+  for (auto _ : bench)
+  {
+    integrator->step(model, state, h, 1);
+    benchmark::DoNotOptimize(state.position.data());
+  }
+  bench.counters["nodes"] = model.nodeCount();
 }
 
 /// The spring force kernel alone: every spring's Hooke + dashpot force, accumulated.
@@ -419,6 +441,9 @@ BENCHMARK_CAPTURE(BM_RopeStepEngine, xpbd, IntegratorType::Xpbd)->Arg(100)->Arg(
 BENCHMARK_CAPTURE(BM_ClothStep, semi_implicit_euler, IntegratorType::SemiImplicitEuler)->Apply(clothSizes);
 BENCHMARK_CAPTURE(BM_ClothStep, xpbd, IntegratorType::Xpbd)->Apply(clothSizes);
 BENCHMARK_CAPTURE(BM_ClothStep, implicit_euler, IntegratorType::ImplicitEuler)->Apply(clothSizes);
+BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, cheaper, LinearSolve::Cheaper)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, direct, LinearSolve::Direct)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, iterative, LinearSolve::Iterative)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothStepImplicitEulerAt60Hz)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothSpringForces)->Arg(10000);
 BENCHMARK(BM_StiffRopeImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000);

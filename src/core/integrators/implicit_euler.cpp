@@ -344,7 +344,7 @@ private:
 
   /// delta_v_ = A^-1 rhs_: directly, A written from the blocks of assemble into the analysed pattern (block
   /// tridiagonal where the free nodes form chains, else sparse), or by conjugate gradients where they cost
-  /// less (see kCgSweepsPerRootCondition). A chain's factorisation costs about as much as one CG sweep, so
+  /// less (see kDirectWorkPerRootCondition). A chain's factorisation costs about as much as one CG sweep, so
   /// a chain always takes the direct path.
   void solve(const Model& model)
   {
@@ -357,7 +357,7 @@ private:
     }
     const bool cheaper_by_cg = linear_solve_ == LinearSolve::Cheaper &&
                                solver_.factorWork() / solver_.matrixEntries() >
-                                   kCgSweepsPerRootCondition * std::sqrt(condition_);
+                                   kDirectWorkPerRootCondition * std::sqrt(condition_);
     if (!factorable_ || cheaper_by_cg)
     {
       buildPreconditioner(model);
@@ -401,16 +401,19 @@ private:
       delta_v_.setConstant(3, model.nodeCount(), std::numeric_limits<double>::quiet_NaN());
   }
 
-  /// Which solve is cheaper. A conjugate-gradient sweep costs one multiply-add per entry of A, and to a
-  /// relative residual of 1e-12 CG takes about ln(2e12) / 2 = 14 sweeps per square root of the
-  /// preconditioned condition number (condition_); a factorisation costs its work per entry. So the
-  /// direct path is taken while work per entry <= 14 sqrt(condition). On a rope the factor has no fill
-  /// (2.9 per entry) and a stiff rope is badly conditioned (k = 1e6 N/m, 1 g nodes, dt = 1/60 s:
-  /// ~1e6): always direct, and linear in the length. On a cloth the fill grows with the node count
-  /// (190 per entry at 1,000 nodes, 770 at 10,000), and at small steps the mass dominates the matrix
-  /// and CG needs few sweeps. Measured (README): the rule picks the faster path or one within a factor
-  /// 1.3 of it.
-  static constexpr double kCgSweepsPerRootCondition = 14.0;
+  /// Which solve is cheaper. A conjugate-gradient sweep costs one multiply-add per entry of A, and CG's
+  /// sweeps to a relative residual of 1e-12 grow like the square root of the preconditioned condition
+  /// number (condition_); a factorisation costs its work per entry. So the direct path is taken while
+  /// work per entry <= C sqrt(condition). The bound ln(2e12) / 2 = 14 sweeps per square root of the
+  /// condition would give C = 14, but CG converges faster than its bound on these spectra and a sparse
+  /// factorisation's multiply-add costs more than a sweep's: measured on the benchmark cloth at
+  /// dt = 1/60 s (bench_step BM_ClothLinearSolveAt60Hz, condition ~840), direct is 1.4 times faster at
+  /// 100 nodes (61 per entry, 2.1 sqrt(condition)) and CG 1.1 times faster at 324 (169 per entry,
+  /// 5.8 sqrt(condition)), 1.8 times at 1,024: C = 4 switches between them. On a rope with bending
+  /// springs the factor has no fill (2.9 per entry) and a stiff rope is badly conditioned (k = 1e6 N/m,
+  /// 1 g nodes, dt = 1/60 s: ~1e6): always direct, and linear in the length. At small steps the mass
+  /// dominates the matrix (condition ~1) and CG serves every cloth.
+  static constexpr double kDirectWorkPerRootCondition = 4.0;
   /// No factorisation is even prepared beyond this work per entry (a 100,000-node cloth would need
   /// 0.75 GB for its factor).
   static constexpr double kMaxFactorWork = 2000.0;
