@@ -157,26 +157,19 @@ def scaling(out):
                 per_spring["%s step, per spring" % integrator] = p[1] / p[2]
         color, marker = STYLE.get(integrator, ("black", "o"))
         axis.plot(nodes, cost, color=color, marker=marker, label="%s: slope %.3f" % (integrator, slope))
-    if rope:
-        # implicit_euler's direct solve on the stiff rope (1e6 N/m, dt = 1/60 s, one Newton iteration).
-        rope.sort()
-        nodes = [p[0] for p in rope]
-        cost = [p[1] * 1e-9 for p in rope]
+    # implicit_euler on the stiff rope (1e6 N/m, one Newton iteration; block tridiagonal) and on the cloths
+    # (sparse LDL^T or CG, whichever the rule picks), both at dt = 1/60 s.
+    for label, points, marker, linestyle in (("stiff rope", rope, "s", "--"), ("cloth", cloth_60hz, "^", ":")):
+        if not points:
+            continue
+        points.sort()
+        nodes = [p[0] for p in points]
+        cost = [p[1] * 1e-9 for p in points]
         slope = fit_slope(nodes, cost)
-        slopes["implicit_euler, stiff rope"] = slope
+        slopes["implicit_euler, %s at 1/60 s" % label] = slope
         color, _ = STYLE.get("implicit_euler", ("black", "o"))
-        axis.plot(nodes, cost, color=color, marker="s", linestyle="--",
-                  label="implicit_euler, stiff rope at 1/60 s: slope %.3f" % slope)
-    if cloth_60hz:
-        # implicit_euler on the same cloths at dt = 1/60 s (sparse LDL^T or CG, whichever the rule picks).
-        cloth_60hz.sort()
-        nodes = [p[0] for p in cloth_60hz]
-        cost = [p[1] * 1e-9 for p in cloth_60hz]
-        slope = fit_slope(nodes, cost)
-        slopes["implicit_euler, cloth at 1/60 s"] = slope
-        color, _ = STYLE.get("implicit_euler", ("black", "o"))
-        axis.plot(nodes, cost, color=color, marker="^", linestyle=":",
-                  label="implicit_euler, cloth at 1/60 s: slope %.3f" % slope)
+        axis.plot(nodes, cost, color=color, marker=marker, linestyle=linestyle,
+                  label="implicit_euler, %s at 1/60 s: slope %.3f" % (label, slope))
     axis.set_xscale("log")
     axis.set_yscale("log")
     axis.set_xlabel("nodes")
