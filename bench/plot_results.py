@@ -123,6 +123,10 @@ def fit_slope(xs, ys):
     return sum((a - mx) * (b - my) for a, b in zip(lx, ly)) / sum((a - mx) ** 2 for a in lx)
 
 
+def node_range(nodes):
+    return "%s to %s nodes" % ("{:,}".format(int(round(min(nodes), -2))), "{:,}".format(int(round(max(nodes), -2))))
+
+
 def scaling(out):
     path = os.path.join(out, "bench_step.json")
     if not os.path.exists(path):
@@ -151,7 +155,7 @@ def scaling(out):
         nodes = [p[0] for p in points]
         cost = [p[1] * 1e-9 for p in points]
         slope = fit_slope(nodes, cost)
-        slopes[integrator] = slope
+        slopes["%s, %s" % (integrator, node_range(nodes))] = slope
         for p in points:
             if p[0] == 10000:
                 per_spring["%s step, per spring" % integrator] = p[1] / p[2]
@@ -166,7 +170,7 @@ def scaling(out):
         nodes = [p[0] for p in points]
         cost = [p[1] * 1e-9 for p in points]
         slope = fit_slope(nodes, cost)
-        slopes["implicit_euler, %s at 1/60 s" % label] = slope
+        slopes["implicit_euler, %s at 1/60 s, %s" % (label, node_range(nodes))] = slope
         color, _ = STYLE.get("implicit_euler", ("black", "o"))
         axis.plot(nodes, cost, color=color, marker=marker, linestyle=linestyle,
                   label="implicit_euler, %s at 1/60 s: slope %.3f" % (label, slope))
@@ -245,7 +249,7 @@ def summary(out, slopes, per_spring):
         for name, ns in per_spring.items():
             lines.append("| %s, 10,000-node cloth | %.2f ns |" % (name, ns))
         for integrator, slope in slopes.items():
-            lines.append("| log-log slope of step cost, 100 to 100,000 nodes, %s | %.3f |" % (integrator, slope))
+            lines.append("| log-log slope of step cost, %s | %.3f |" % (integrator, slope))
         lines.append("")
     memory = read_csv(os.path.join(out, "memory.csv"))
     if memory:
