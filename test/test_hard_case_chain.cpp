@@ -7,12 +7,14 @@
 // linear system, and keeps Gauss-Seidel for everything else.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include "catenary.h"
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "test_util.h"
@@ -485,11 +487,11 @@ TEST(HardCase2NotAChain, AClothNextToTheChainEndsExactlyWhereItDoesAlone)
         << "segment " << j;
 }
 
-// An even rope is no heavy chain: Gauss-Seidel carries its load, and it keeps the sweep, with the
-// sweep's robustness to rows turning fast. A regression pin, as the cloth's: an inextensible 51-node
+// An even rope with a free end keeps the sweep, with the sweep's robustness to rows turning fast. A regression pin, as the cloth's: an inextensible 51-node
 // rope of 1 m swinging down from horizontal at h = 10 ms, after 1 s, as the sweep computed it before the
 // chain solve existed. (That answer is itself far off, the end 3.7 m below the pin, but finite; the
-// linearised direct solve took the same rope to NaN.)
+// linearised direct solve took the same rope to NaN; with the geometric stiffness and a load limit, it
+// stayed finite but gained energy from the 8th step on.)
 TEST(HardCase2NotAChain, AnEvenRopeIsSweptByGaussSeidelAsBeforeEvenAtLargeSteps)
 {
   SceneDef scene;
@@ -509,6 +511,42 @@ TEST(HardCase2NotAChain, AnEvenRopeIsSweptByGaussSeidelAsBeforeEvenAtLargeSteps)
   EXPECT_NEAR(positionHash(world, 0, nodes), -11353.695151765842, 1e-9);
   EXPECT_TRUE(expectNear(Vec3(world.state().position.col(nodes - 1)), Vec3(-0.21853025562934761, 0, -3.682156836109796),
                          1e-12));
+}
+
+// An even chain pinned at both ends, solved directly: the work-precision report's inextensible hanging
+// chain (1 m, 0.1 kg, 51 nodes, supports 0.8 m apart, released from a V and settled by drag 8 1/s for
+// 3 s) at dt = 10 ms, 2 sub-steps. At rest the direct solve reaches XPBD's fixed point, whose one Newton
+// step leaves the rows off by the square of a sub-step's correction, (h^2 g)^2 / l ~ 3e-7 m, and the
+// slowest mode has decayed by e^-24: 1e-5 m from the discrete catenary allows for both. (Gauss-Seidel's
+// one sweep is off by g h^2 N^2 / pi^2 ~ 6 cm here.)
+TEST(HardCase2EvenChain, AnInextensibleChainPinnedAtBothEndsSettlesOnTheDiscreteCatenary)
+{
+  const int nodes = 51;
+  const double rest = 1.0 / (nodes - 1);
+  const double node_mass = 0.1 / nodes;
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::Xpbd;
+  scene.physics.step = StepSettings{ 0.01, 2, 1 };
+  scene.physics.gravity = Vec3(0, 0, -kGravity);
+  scene.physics.drag = 8.0;
+  BodyDef chain;
+  chain.name = "chain";
+  const int middle = (nodes - 1) / 2;
+  for (int j = 0; j < nodes; ++j)
+  {
+    const double along = std::abs(j - middle) * rest;
+    chain.nodes.push_back(NodeDef{ Vec3(0.4 + (j < middle ? -1 : 1) * along * 0.8, 0.0, -0.3 + along * 0.6), node_mass,
+                                   Vec3::Zero(), j == 0 || j == nodes - 1 });
+  }
+  for (int j = 1; j < nodes; ++j)
+    chain.constraints.push_back(ConstraintDef{ j - 1, j, 0.0, rest });
+  scene.bodies.push_back(chain);
+  World world = buildWorld(scene);
+  for (int n = 0; n < 300; ++n)
+    world.step();
+  const Eigen::Matrix3Xd truth =
+      discreteCatenary(nodes, node_mass, std::numeric_limits<double>::infinity(), rest, 0.8);
+  EXPECT_LT((world.state().position - truth).colwise().norm().maxCoeff(), 1e-5);
 }
 
 // Bending springs to second neighbours give each free node four rows: no chain, so xpbd sweeps them by

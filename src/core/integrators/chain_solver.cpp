@@ -12,9 +12,16 @@ namespace
 {
 constexpr std::int64_t kNone = -1;
 
-/// A chain is solved directly only if its heaviest free node weighs at least this many times its
-/// lightest: the usual rule of thumb keeps iterative constraint solvers below a mass ratio of 10.
+/// Chains whose heaviest free node weighs this many times their lightest are heavy: the usual rule of
+/// thumb keeps iterative constraint solvers below a mass ratio of 10.
 constexpr double kMassRatio = 10.0;
+
+/// The largest load h^2 T / (m l) at which an even chain is solved directly (ChainSolver::solve).
+constexpr double kEvenLoad = 1.0;
+
+/// The largest move [rest lengths] of a node in one step of a chain pinned at both ends (ChainSolver).
+constexpr double kReach = 1.0;
+
 }  // namespace
 
 RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const Eigen::VectorXd& inverse_mass)
@@ -66,11 +73,10 @@ RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const E
   }
   // Each connected set of rows: a chain if nothing branches, it has two or more rows and it has one link
   // fewer than rows (with at most two links per row, the connected graphs without a cycle are paths;
-  // two rows on the same two free nodes count as two links, a cycle), and one of its two end rows ends
-  // in a free node of its own. Without such a free end (pinned at both ends), a straight chain's rows
-  // are linearly dependent and an inextensible one's system singular: a taut or compressed chain
-  // between two supports can only leave the line to second order, which the linearised solve cannot
-  // see, so such chains stay with Gauss-Seidel's nonlinear projections.
+  // two rows on the same two free nodes count as two links, a cycle). Pinned at both ends, a straight
+  // chain's rows are linearly dependent and an inextensible one's system singular: a taut or compressed
+  // chain between two supports can leave the line only to second order, which the linearised step cannot
+  // see; it answers with moves of C / theta for a bend theta. Such steps are refused (ChainSolver::solve).
   RowPartition partition;
   partition.chain_starts.push_back(0);
   std::vector<std::uint8_t> visited(row_count, 0);
@@ -109,22 +115,16 @@ RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const E
     }
     if (branches || component.size() < 2 || links != 2 * (component.size() - 1))
       continue;
-    // Walk the path from its free end: eliminating from there, each pivot of the Thomas algorithm in a
-    // straight chain is at least the inverse mass of its row's node toward the support, with no
-    // cancellation against a lighter neighbour (from the support, the last pivot is
+    // Walk the path from its free end if it has one: eliminating from there, each pivot of the Thomas
+    // algorithm in a straight chain is at least the inverse mass of its row's node toward the support,
+    // with no cancellation against a lighter neighbour (from the support, the last pivot is
     // w_end = (w_next + w_end) - w_next, which loses w_next / w_end of its digits: all of them at a mass
-    // ratio of 1e16).
+    // ratio of 1e16). Pinned at both ends, from either.
     std::int64_t current = kNone;
     for (const std::size_t r : component)
-      if (neighbours[r][1] == kNone && freeEnd(r))
+      if (neighbours[r][1] == kNone && (current == kNone || freeEnd(r)))
         current = static_cast<std::int64_t>(r);
-    if (current == kNone)
-      continue;
-    // And only where Gauss-Seidel fails. It moves each node by its share w_i / (w_i + w_j) of a
-    // correction: an even chain takes its load within a few sweeps (every rope scene), a heavy node
-    // pulls through (hard case 2). Where rows turn fast the one linearised step is the less robust of
-    // the two: a 51-node even rope swinging at h = 10 ms stays finite with Gauss-Seidel and went to NaN
-    // with the direct solve.
+    // An even chain with a free end keeps the sweep (see RowPartition).
     double lightest = std::numeric_limits<double>::infinity();
     double heaviest = 0.0;
     for (const std::size_t r : component)
@@ -134,7 +134,7 @@ RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const E
           lightest = std::min(lightest, 1.0 / inverse_mass[node]);
           heaviest = std::max(heaviest, 1.0 / inverse_mass[node]);
         }
-    if (heaviest < kMassRatio * lightest)
+    if (heaviest < kMassRatio * lightest && freeEnd(static_cast<std::size_t>(current)))
       continue;
     std::int64_t previous = kNone;
     while (current != kNone)
@@ -147,6 +147,7 @@ RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const E
       current = next;
     }
     partition.chain_starts.push_back(static_cast<std::uint32_t>(partition.chain_rows.size()));
+    partition.chain_heavy.push_back(heaviest >= kMassRatio * lightest ? 1 : 0);
   }
   for (std::size_t r = 0; r < row_count; ++r)
     if (!in_chain[r])
@@ -169,13 +170,18 @@ void ChainSolver::reserve(std::size_t rows)
   coupling_.resize(rows);
   coupling_below_.resize(rows);
   rhs_.resize(rows);
+  lag_.resize(3, n);
+  push_a_.resize(3, n);
+  push_b_.resize(3, n);
+  step_a_.resize(3, n);
+  step_b_.resize(3, n);
   upper_.resize(rows);
   delta_.resize(rows);
 }
 
-void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
+ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
                         const NodeArray& x_prev, double h, const double* tension, const NodeHolds* holds,
-                        bool push, NodeArray& x, double* lambda)
+                        const NodeArray* correction, bool push, NodeArray& x, double* lambda)
 {
   for (std::size_t i = 0; i < count; ++i)
   {
@@ -184,7 +190,34 @@ void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::Ve
     start_lambda_[i] = lambda[i];
     estimate_[i] = tension[i];
   }
-  newtonStep(rows, count, inverse_mass, x_prev, h, holds, push, x, lambda);
+  // An even chain whose tension impulse rivals its nodes' masses is refused (see the class comment).
+  double lightest = std::numeric_limits<double>::infinity();
+  double heaviest = 0.0;
+  double load = 0.0;
+  for (std::size_t i = 0; i < count; ++i)
+    for (const int node : { rows[i].a, rows[i].b })
+      if (inverse_mass[node] > 0.0)
+      {
+        lightest = std::min(lightest, 1.0 / inverse_mass[node]);
+        heaviest = std::max(heaviest, 1.0 / inverse_mass[node]);
+        load = std::max(load,
+                        h * h * tension[i] * inverse_mass[node] / std::max(rows[i].rest_length, kMinSpringLength));
+      }
+  const bool even = heaviest < kMassRatio * lightest;
+  const auto outer = [&](std::size_t i, std::size_t next) {
+    return rows[i].a == rows[next].a || rows[i].a == rows[next].b ? rows[i].b : rows[i].a;
+  };
+  const bool bounded = count > 1 && inverse_mass[outer(0, 1)] == 0.0 && inverse_mass[outer(count - 1, count - 2)] == 0.0;
+  if (even && load > kEvenLoad)
+    return kLoaded;
+  // The lumped stiffness's known part (see the class comment) only on even chains: on the heavy chain of
+  // hard case 2 it broke two bounds (a pendulum's segment strain 1.04 % > 1 %, and the folded chain
+  // snapping taut gained 0.66 J), and a heavy chain hangs nearly straight, where P g, the bias it
+  // removes, is small.
+  if (!even)
+    correction = nullptr;
+  if (!newtonStep(rows, count, inverse_mass, x_prev, h, holds, correction, push, bounded, x, lambda))
+    return kSingular;
   // This sub-step's tension -lambda / h^2 against the estimate its geometric stiffness used.
   const double inverse_h2 = 1.0 / (h * h);
   bool underestimated = false;
@@ -197,8 +230,10 @@ void ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::Ve
   if (underestimated)
   {
     restart(rows, count, x, lambda);
-    newtonStep(rows, count, inverse_mass, x_prev, h, holds, push, x, lambda);
+    if (!newtonStep(rows, count, inverse_mass, x_prev, h, holds, correction, push, bounded, x, lambda))
+      return kSingular;
   }
+  return kSolved;
 }
 
 void ChainSolver::restart(const SweepRow* rows, std::size_t count, NodeArray& x, double* lambda) const
@@ -211,9 +246,9 @@ void ChainSolver::restart(const SweepRow* rows, std::size_t count, NodeArray& x,
   }
 }
 
-void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
-                             const NodeArray& x_prev, double h, const NodeHolds* holds, bool push, NodeArray& x,
-                             double* lambda)
+bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
+                             const NodeArray& x_prev, double h, const NodeHolds* holds,
+                             const NodeArray* correction, bool push, bool bounded, NodeArray& x, double* lambda)
 {
   // Each row at the current positions (as projectDistance, but every row at the same x): its direction,
   // its right-hand side -C - alpha~ lambda - gamma u . ((x_a - x_prev_a) - (x_b - x_prev_b)), and its
@@ -252,17 +287,47 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     if (i + 1 < count)
       shared_before = row.a == rows[i + 1].a || row.a == rows[i + 1].b ? row.a : row.b;
   }
-  // The displacement W~ h^2 f of the kinetic friction that the rows do not cause (NodeHolds::push) enters
-  // each row's linearisation.
-  const bool pushing = push && holds != nullptr;
-  const auto pushed = [&](int node, const Matrix3& mobility) -> Vec3 {
-    return holds->kind[static_cast<std::size_t>(node)] == NodeHolds::kSlide ? Vec3(mobility * holds->push.col(node))
-                                                                             : Vec3::Zero();
-  };
+  // The known forces of the first Newton step, as impulses h^2 f [kg m] on each row's two nodes
+  // (ChainSolver::solve): kinetic friction that the rows do not cause (NodeHolds::push) and the part of the
+  // lumped geometric stiffness that the exact one does not have, at the last sub-step's correction c:
+  // per row, 2 h^2 T / l P c_k - h^2 T / l P (c_k - c_other) = h^2 T / l P (c_a + c_b) on each node.
+  const bool pushing = push && (holds != nullptr || correction != nullptr);
   if (pushing)
+  {
     for (std::size_t i = 0; i < count; ++i)
-      rhs_[i] -= direction_.col(static_cast<Eigen::Index>(i))
-                     .dot(pushed(rows[i].a, mobility_a_[i]) - pushed(rows[i].b, mobility_b_[i]));
+    {
+      const Eigen::Index column = static_cast<Eigen::Index>(i);
+      push_a_.col(column).setZero();
+      push_b_.col(column).setZero();
+      if (holds != nullptr)
+        for (const int node : { rows[i].a, rows[i].b })
+          if (holds->kind[static_cast<std::size_t>(node)] == NodeHolds::kSlide)
+            (node == rows[i].a ? push_a_ : push_b_).col(column) = holds->push.col(node);
+      lag_.col(column).setZero();
+      if (correction != nullptr && geometric_[i] != 0.0)
+      {
+        const Vec3 u = direction_.col(column);
+        const Vec3 sum = correction->col(rows[i].a) + correction->col(rows[i].b);
+        lag_.col(column) = 0.5 * geometric_[i] * (sum - u * u.dot(sum));
+      }
+    }
+    // A node's lag is the sum over its rows: this row's and the neighbour's that shares the node.
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      const Eigen::Index column = static_cast<Eigen::Index>(i);
+      for (const int node : { rows[i].a, rows[i].b })
+      {
+        Vec3 lag = lag_.col(column);
+        for (const std::size_t k : { i - 1, i + 1 })
+          if (k < count && (rows[k].a == node || rows[k].b == node))
+            lag += lag_.col(static_cast<Eigen::Index>(k));
+        (node == rows[i].a ? push_a_ : push_b_).col(column) += lag;
+      }
+      push_a_.col(column) = mobility_a_[i] * push_a_.col(column);
+      push_b_.col(column) = mobility_b_[i] * push_b_.col(column);
+      rhs_[i] -= direction_.col(column).dot(push_a_.col(column) - push_b_.col(column));
+    }
+  }
   // The system with row i divided by 1 + gamma_i, tridiagonal, and symmetric positive definite but where
   // kinetic friction makes a sliding node's W~ unsymmetric (mobility()):
   //   diagonal_i = u_i . (W~_a + W~_b) u_i + alpha~_i / (1 + gamma_i),
@@ -288,9 +353,10 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
   // Thomas algorithm (LDL^T of a tridiagonal matrix, LU where it is unsymmetric): for a symmetric positive
   // definite matrix it is stable without pivoting and every pivot is positive; friction's unsymmetric part
   // is at most mu times a sliding node's normal coupling. With a free end the rows are independent, so a
-  // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); one within the
-  // round-off of the subtraction that made it is treated as zero: its row keeps dlambda = 0 and the
-  // others are solved without it, rather than divided by noise.
+  // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); pinned at both ends, the
+  // last one vanishes where the chain is straight (partitionRows). One within the round-off of the
+  // subtraction that made it is treated as zero: its row keeps dlambda = 0 and the others are solved
+  // without it, rather than divided by noise.
   constexpr double kPivotFloor = 64.0 * std::numeric_limits<double>::epsilon();
   for (std::size_t i = 0; i < count; ++i)
   {
@@ -308,26 +374,38 @@ void ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
   }
   for (std::size_t i = count - 1; i-- > 0;)
     delta_[i] -= upper_[i] * delta_[i + 1];
-  // x += W~ J^T dlambda, row by row.
+  // x += W~ J^T dlambda, row by row; on a chain pinned at both ends (`bounded`) only if no node moves by
+  // more than kReach rest lengths (see ChainSolver::solve): else nothing is changed.
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    const Eigen::Index column = static_cast<Eigen::Index>(i);
+    const Vec3 u = direction_.col(column);
+    step_a_.col(column) = mobility_a_[i] * (delta_[i] * u);
+    step_b_.col(column) = mobility_b_[i] * (delta_[i] * u);
+    const double reach = kReach * rows[i].rest_length;
+    if (bounded &&
+        (step_a_.col(column).squaredNorm() > reach * reach || step_b_.col(column).squaredNorm() > reach * reach))
+      return false;
+  }
   for (std::size_t i = 0; i < count; ++i)
   {
     const SweepRow& row = rows[i];
-    const Vec3 u = direction_.col(static_cast<Eigen::Index>(i));
     lambda[i] += delta_[i];
-    x.col(row.a) += mobility_a_[i] * (delta_[i] * u);
-    x.col(row.b) -= mobility_b_[i] * (delta_[i] * u);
+    x.col(row.a) += step_a_.col(static_cast<Eigen::Index>(i));
+    x.col(row.b) -= step_b_.col(static_cast<Eigen::Index>(i));
   }
-  // ... and that displacement, once per node (a node shared with the row before has had it).
+  // ... and those displacements, once per node (a node shared with the row before has had it).
   if (pushing)
     for (std::size_t i = 0; i < count; ++i)
     {
       const SweepRow& row = rows[i];
       const auto first_time = [&](int node) { return i == 0 || (rows[i - 1].a != node && rows[i - 1].b != node); };
       if (first_time(row.a))
-        x.col(row.a) += pushed(row.a, mobility_a_[i]);
+        x.col(row.a) += push_a_.col(static_cast<Eigen::Index>(i));
       if (first_time(row.b))
-        x.col(row.b) += pushed(row.b, mobility_b_[i]);
+        x.col(row.b) += push_b_.col(static_cast<Eigen::Index>(i));
     }
+  return true;
 }
 
 ChainSolver::Matrix3 ChainSolver::mobility(const SweepRow* rows, std::size_t count, std::size_t i, int node,

@@ -16,24 +16,30 @@ namespace soft_body_sim
 /// where (J W J^T)_ij = sum over nodes k of w_k gradC_i(k) . gradC_j(k): two rows couple only through a
 /// free node they share (w = 0 at a pinned one). When every free node joins at most two rows and the
 /// rows so coupled form no cycle, each connected set of rows is a path, and in path order its matrix is
-/// tridiagonal. If the path also ends in a free node (a chain hanging from at most one support, or
-/// none), its rows are independent in any shape, and the system is solved exactly in O(n) by the
-/// Thomas algorithm, with no fill-in (Deul, Kugelstadt, Weiler, Bender 2018, "Direct Position-Based
-/// Solver for Stiff Rods": tree-structured systems; a path is the simplest tree). Gauss-Seidel, which moves the end of a chain by w_end / (w_end + w_next) of
-/// each correction, cannot carry a heavy end mass; the direct solve does at any mass ratio. It is used
-/// where that is needed, on chains whose masses differ by a factor of 10 or more; even chains, whose
-/// load Gauss-Seidel carries, keep its sweep and its robustness to rows turning fast.
+/// tridiagonal, solved exactly in O(n) by the Thomas algorithm, with no fill-in (Deul, Kugelstadt, Weiler,
+/// Bender 2018, "Direct Position-Based Solver for Stiff Rods": tree-structured systems; a path is the
+/// simplest tree). Gauss-Seidel moves the end of a chain by w_end / (w_end + w_next) of each correction
+/// and cannot carry a heavy end mass; on an even chain pinned at both ends its error at rest grows like
+/// g h^2 N^2 / (pi^2 sweeps) (the inextensible hanging chain of the work-precision report needed 32
+/// sub-steps of 10 ms at 51 nodes and 128 at 201 for 1 mm; solved directly, 2 and 8, 2e-7 m at rest).
+/// So every chain is solved directly but an even one (masses within a factor of 10) with a free end:
+/// swinging at large steps, its rows turn fast and the linearised step runs away where the sweep stays
+/// finite (measured: a 1 m, 0.1 kg inextensible rope released from horizontal, pinned at one end,
+/// gained 1e7 J within 0.3 s at 51 nodes and h = 5 ms, and at 201 nodes and h = 2.5 ms; it was stable
+/// and 3000 times less stretched than by the sweep at a quarter of those steps). Gauss-Seidel's error on
+/// such a rope is its stretch, not a bias at rest: it keeps the sweep.
 struct RowPartition
 {
   std::vector<std::uint32_t> swept;        ///< rows left to Gauss-Seidel, in model order
   std::vector<std::uint32_t> chain_rows;   ///< the rows of every chain, each in path order, one after another
   std::vector<std::uint32_t> chain_starts; ///< chain c is chain_rows[chain_starts[c], chain_starts[c + 1])
+  std::vector<std::uint8_t> chain_heavy;   ///< per chain: 1 if its masses differ by a factor of 10 or more
 };
 
-/// Splits rows (given by their end nodes, ends[r] = {a, b}) into chains of two or more rows with a free
-/// end and a mass ratio of 10 or more, each listed from that end, and the rest. A chain of one row is
-/// left to the sweep: for a single row the Gauss-Seidel update is the exact solve. Depends on which
-/// nodes are free: recompute it when a node is pinned or released.
+/// Splits rows (given by their end nodes, ends[r] = {a, b}) into chains of two or more rows, heavy ones
+/// listed from a free end if they have one, even ones only if pinned at both ends, and the rest. A chain of one row is left to the sweep: for a single row
+/// the Gauss-Seidel update is the exact solve. Depends on which nodes are free: recompute it when a node
+/// is pinned or released.
 RowPartition partitionRows(const std::vector<std::pair<int, int>>& ends, const Eigen::VectorXd& inverse_mass);
 
 /// How contacts hold the nodes of the chains in their solve (chain_contacts.h), per node of the model.
@@ -75,10 +81,41 @@ struct NodeHolds
 /// statics, is unchanged; what it costs is inertia against sideways motion of nodes whose tension
 /// impulse h^2 T / l rivals their mass.
 ///
+/// A chain that sags is not straight: lumped, the stiffness also resists a translation, which the exact
+/// one does not (its rows' blocks [P -P; -P P] sum to zero), and at rest every node moves by -h^2 g per
+/// sub-step: the lumped term alone shifts the rest state by O(h^2) (measured on the hanging chain of
+/// the work-precision report: 5.5e-4 m at 51 nodes and h = 1.25 ms, 2e-3 m at 201 nodes and h = 0.6 ms).
+/// On an even chain the difference, per row h^2 T / l P (c_a + c_b) on each of its nodes, is applied as a
+/// known force at the correction c = x - x~ of the last sub-step (like kinetic friction's push): at rest c repeats, and the
+/// rest state is exactly XPBD's (error 2e-7 m at both sizes); the zig-zag mode, which the difference
+/// does not contain, keeps its implicit damping.
+///
 /// T is this sub-step's tension, known only after the solve: the step uses the last sub-step's, and if
 /// the solve finds more than twice that in any row (a slack chain jerked taut by its end mass: measured,
 /// a heavy inextensible chain gained energy without bound from such snaps), it is repeated from the same
 /// positions with the larger of the two. A steady or slowly changing load costs one solve.
+///
+/// Where rows turn fast the one linearised step is less robust than Gauss-Seidel's nonlinear projections,
+/// also between two supports. Measured on the hanging chain released from a V, with the load
+/// h^2 T / (m l) of its last sub-step's tensions: every run whose load stayed below 0.66 converged (51
+/// nodes at h = 5 ms, 201 at 1.25 ms); at 51 nodes and h = 10 ms (0.76 from the start) and at 201 and
+/// 2.5 ms (0.74), it grew past 1 and then ran away to NaN within a few sub-steps. So an even chain whose
+/// load at any free node exceeds 1 is refused (solve() returns kLoaded) and left to the sweep. A heavy
+/// chain, which the sweep cannot carry, is always solved directly (hard case 2: stable at a load of ~2
+/// while straight).
+///
+/// Pinned at both ends, a nearly straight chain's system is nearly singular, and a step that must bend
+/// it (a chain released straight and 20 % compressed between its supports) moves nodes by many rest
+/// lengths. Measured on 21 nodes of 0.01 kg, 1 m between supports 0.8 m apart, released straight: at
+/// h = 1 ms the direct solve blew up (a guard event) and stretched its chain to 94 m at h = 4.2 ms. So a
+/// step of such a chain that would move any node by more than one rest length is refused for that
+/// sub-step (kSingular) and the sweep takes it: it settles at its length, 1.00000 m, within 2.6 % on the
+/// way. The same bound makes a heavy chain between two supports (a 10 kg node in the middle) mostly
+/// swept, as before: measured, the sweep stretches it by 12 % (h = 1 ms) to 160 % (h = 4.2 ms); solved
+/// directly at 4.2 ms it hung 0.2995 m deep (0.3 m for massless arms), but blew up at 1 ms. For a step
+/// refused once the sweep is no worse than before this solve existed; the load refusal (kLoaded) is kept
+/// until the rows are ordered again, because switching back and forth between the two is worse than
+/// either (Xpbd::solveChains).
 class ChainSolver
 {
 public:
@@ -86,22 +123,33 @@ public:
 
   /// One Newton step on the chain `rows` (count consecutive rows in path order, count <= the reserved
   /// size) for a sub-step of h [s], with `tension` [N] per row from the last sub-step (repeated once
-  /// with this one's if that was too small, see above): builds the tridiagonal system at the current
-  /// positions, solves it, and applies
+  /// with this one's if that was too small, see above), unless it is an even chain loaded beyond its
+  /// stable range or a nearly singular step (see above): then it says which and changes nothing. Builds the tridiagonal system
+  /// at the current positions, solves it, and applies
   ///   lambda_i += dlambda_i,  x_a += W~_a u_i dlambda_i,  x_b -= W~_b u_i dlambda_i
   /// to every row at once. A row that cannot move (both ends pinned or stuck, or coincident ends) keeps
   /// dlambda = 0 and decouples from its neighbours. `holds` (null: none) restrict the nodes held by
   /// contacts: W~ of a stuck node is 0, of a sliding one P W~ P with P = I - n n^T; with `push`, their
-  /// kinetic friction acts in this step.
-  void solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-             double h, const double* tension, const NodeHolds* holds, bool push, NodeArray& x, double* lambda);
+  /// kinetic friction acts in this step, and with `correction` (null: none; per node of the model, the
+  /// last sub-step's x - x~ [m]) the lumped stiffness's difference from the exact one (see above).
+  enum Outcome
+  {
+    kSolved,
+    kSingular,  ///< refused for this sub-step: nearly singular, a node would move too far (see above)
+    kLoaded,    ///< refused: an even chain loaded beyond its stable range (see above)
+  };
+
+  Outcome solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+             double h, const double* tension, const NodeHolds* holds, const NodeArray* correction, bool push,
+             NodeArray& x, double* lambda);
 
 private:
   using Matrix3 = Eigen::Matrix3d;
 
   /// The step itself, with the geometric stiffness of the tensions in estimate_.
-  void newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-                  double h, const NodeHolds* holds, bool push, NodeArray& x, double* lambda);
+  bool newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+                  double h, const NodeHolds* holds, const NodeArray* correction, bool push, bool bounded,
+                  NodeArray& x, double* lambda);
 
   /// Puts the chain's nodes and lambdas back where solve() found them.
   void restart(const SweepRow* rows, std::size_t count, NodeArray& x, double* lambda) const;
@@ -122,6 +170,11 @@ private:
   std::vector<double> coupling_;        ///< (J W~ J^T)_{i,i+1}
   std::vector<double> coupling_below_;  ///< (J W~ J^T)_{i+1,i}: the same unless kinetic friction acts there
   std::vector<double> rhs_;
+  NodeArray lag_;                 ///< per row, h^2 T / l P (c_a + c_b) [kg m] (see newtonStep)
+  NodeArray push_a_;              ///< the known displacement W~ h^2 f of each row's node a in the first step [m]
+  NodeArray push_b_;              ///< ... and of its node b
+  NodeArray step_a_;              ///< the displacement W~_a u dlambda of each row's node a [m]
+  NodeArray step_b_;              ///< ... and of its node b
   std::vector<double> upper_;     ///< the Thomas algorithm's modified super-diagonal c'_i
   std::vector<double> delta_;     ///< its modified right-hand side d'_i, then dlambda_i
 };
