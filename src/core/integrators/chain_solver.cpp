@@ -180,8 +180,8 @@ void ChainSolver::reserve(std::size_t rows)
 }
 
 ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
-                        const NodeArray& x_prev, double h, const double* tension, const NodeHolds* holds,
-                        const NodeArray* correction, bool push, NodeArray& x, double* lambda)
+                        const NodeArray& x_prev, double h, const double* tension, bool heavy,
+                        const NodeHolds* holds, const NodeArray* correction, bool push, NodeArray& x, double* lambda)
 {
   for (std::size_t i = 0; i < count; ++i)
   {
@@ -191,19 +191,12 @@ ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count,
     estimate_[i] = tension[i];
   }
   // An even chain whose tension impulse rivals its nodes' masses is refused (see the class comment).
-  double lightest = std::numeric_limits<double>::infinity();
-  double heaviest = 0.0;
+  const bool even = !heavy;
   double load = 0.0;
-  for (std::size_t i = 0; i < count; ++i)
+  for (std::size_t i = 0; even && i < count; ++i)
     for (const int node : { rows[i].a, rows[i].b })
-      if (inverse_mass[node] > 0.0)
-      {
-        lightest = std::min(lightest, 1.0 / inverse_mass[node]);
-        heaviest = std::max(heaviest, 1.0 / inverse_mass[node]);
-        load = std::max(load,
-                        h * h * tension[i] * inverse_mass[node] / std::max(rows[i].rest_length, kMinSpringLength));
-      }
-  const bool even = heaviest < kMassRatio * lightest;
+      load = std::max(load,
+                      h * h * tension[i] * inverse_mass[node] / std::max(rows[i].rest_length, kMinSpringLength));
   const auto outer = [&](std::size_t i, std::size_t next) {
     return rows[i].a == rows[next].a || rows[i].a == rows[next].b ? rows[i].b : rows[i].a;
   };

@@ -132,6 +132,7 @@ public:
   /// contacts: W~ of a stuck node is 0, of a sliding one P W~ P with P = I - n n^T; with `push`, their
   /// kinetic friction acts in this step, and with `correction` (null: none; per node of the model, the
   /// last sub-step's x - x~ [m]) the lumped stiffness's difference from the exact one (see above).
+  /// `heavy`: the chain's masses differ by 10 or more (RowPartition::chain_heavy).
   enum Outcome
   {
     kSolved,
@@ -140,8 +141,8 @@ public:
   };
 
   Outcome solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-             double h, const double* tension, const NodeHolds* holds, const NodeArray* correction, bool push,
-             NodeArray& x, double* lambda);
+                double h, const double* tension, bool heavy, const NodeHolds* holds, const NodeArray* correction,
+                bool push, NodeArray& x, double* lambda);
 
 private:
   using Matrix3 = Eigen::Matrix3d;

@@ -192,7 +192,7 @@ private:
       ChainSolver::Outcome outcome = ChainSolver::kLoaded;
       if (!swept_chain_[c])
         outcome = chains_.solve(&rows_[first], count, model.inverse_mass, previous_, h, chain_tension_.data() + first,
-                                holds, &correction_, iteration == 0, x, lambda_.data() + first);
+                                chain_heavy_[c] != 0, holds, &correction_, iteration == 0, x, lambda_.data() + first);
       swept_chain_[c] = outcome == ChainSolver::kLoaded;
       if (outcome != ChainSolver::kSolved)
         for (std::size_t k = first; k < first + count; ++k)
@@ -255,7 +255,7 @@ private:
     }
     chains_.reserve(longest);
     chain_tension_.setZero(static_cast<Eigen::Index>(order_.size()));
-    correction_.setZero(3, model.nodeCount());
+    correction_.setZero(3, chain_starts_.size() > 1 ? model.nodeCount() : 0);  // only a chain's solve reads it
     swept_chain_.assign(chain_starts_.size(), 0);
     // Each chain's nodes in path order, and its rows between them, for the contacts in its solve.
     // Contacts act inside the solve of heavy chains only (chain_contacts.h: a load held by friction on
