@@ -7,8 +7,8 @@
 // (items = spring updates) and how the step cost grows with the node count (scripts/bench fits the
 // log-log slope); BM_ClothSpringForces is the force kernel alone on the 10,000-node cloth.
 // BM_StiffRopeImplicitEuler/<nodes>: implicit Euler's direct solve on a stiff rope, 100 to 100,000 nodes;
-// BM_ClothStepImplicitEulerAt60Hz/<nodes>: implicit Euler on the cloths at dt = 1/60 s, 100 to 10,000;
-// BM_ClothLinearSolveAt60Hz/<cheaper|direct|iterative>/<nodes>: the same with each linear solve path.
+// BM_ClothLinearSolveAt60Hz/<cheaper|direct|iterative>/<nodes>: implicit Euler on the cloths at dt = 1/60 s,
+// 100 to 10,000 nodes, its linear solve made each way (cheaper: the rule's choice, what a scene gets).
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
 // capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
@@ -102,24 +102,6 @@ void BM_ClothStep(benchmark::State& bench, IntegratorType integrator)
   }
   bench.counters["nodes"] = world.model().nodeCount();
   bench.counters["springs"] = static_cast<double>(world.model().springs.size());
-  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(world.model().springs.size()));
-}
-
-/// implicit_euler on the same cloths at a ROS node's step, dt = 1/60 s, where a cloth's springs outweigh
-/// its node masses (h^2 k / m ~ 200) and the solve (sparse LDL^T or conjugate gradients, whichever the
-/// rule picks) sets the cost.
-void BM_ClothStepImplicitEulerAt60Hz(benchmark::State& bench)
-{
-  SceneDef scene = clothScene(static_cast<int>(bench.range(0)), IntegratorType::ImplicitEuler);
-  scene.physics.step.dt = 1.0 / 60.0;
-  World world = buildWorld(scene);
-  world.step();
-  for (auto _ : bench)
-  {
-    world.step();
-    benchmark::DoNotOptimize(world.state().position.data());
-  }
-  bench.counters["nodes"] = world.model().nodeCount();
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(world.model().springs.size()));
 }
 
@@ -444,7 +426,6 @@ BENCHMARK_CAPTURE(BM_ClothStep, implicit_euler, IntegratorType::ImplicitEuler)->
 BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, cheaper, LinearSolve::Cheaper)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, direct, LinearSolve::Direct)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, iterative, LinearSolve::Iterative)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
-BENCHMARK(BM_ClothStepImplicitEulerAt60Hz)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothSpringForces)->Arg(10000);
 BENCHMARK(BM_StiffRopeImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000);
 BENCHMARK_CAPTURE(BM_RopeOnColliders, sphere, Shape::Sphere)->Args({ 1000, 0 })->Args({ 1000, 10 });
