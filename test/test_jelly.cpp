@@ -266,7 +266,7 @@ TEST(PressureCell, ForcesAreMinusTheGradientOfTheEnergyWithNoNetForceOrTorque)
   NodeArray force = NodeArray::Zero(3, 4);
   accumulatePressureForces(model, x, force);
   const double d = 1e-7;
-  State state{ x, NodeArray::Zero(3, 4) };
+  State state{ x, NodeArray::Zero(3, 4), {} };
   for (int k = 0; k < 4; ++k)
     for (int axis = 0; axis < 3; ++axis)
     {

@@ -2,8 +2,25 @@
 
 namespace soft_body_sim
 {
+namespace
+{
+/// The index in model.rods of the rod whose held end `end` (0 first, 1 last) is node `node`, or -1.
+int heldRodEnd(const Model& model, int node, int& end)
+{
+  for (std::size_t r = 0; r < model.rods.size(); ++r)
+    for (end = 0; end < 2; ++end)
+      if (model.rods[r].held[end] && node == (end == 0 ? model.rods[r].first : model.rods[r].last()))
+        return static_cast<int>(r);
+  return -1;
+}
+}  // namespace
+
 AnchorSet::AnchorSet(std::size_t scene_anchors)
-  : goals_(scene_anchors), paths_(scene_anchors), scene_anchors_(scene_anchors)
+  : goals_(scene_anchors)
+  , paths_(scene_anchors)
+  , turns_(scene_anchors)
+  , turned_from_(scene_anchors, Eigen::Quaterniond::Identity())
+  , scene_anchors_(scene_anchors)
 {
 }
 
@@ -22,12 +39,19 @@ void AnchorSet::goalsFromPaths(double t)
       goals_[k] = paths_[k](t);
 }
 
-bool AnchorSet::setVelocities(const Model& model, State& state, double dt) const
+bool AnchorSet::setVelocities(const Model& model, State& state, double dt)
 {
   bool moved = false;
   for (std::size_t k = 0; k < model.anchors.size(); ++k)
   {
     const int node = model.anchors[k].node;
+    int end = 0;
+    if (const int r = turns_[k] ? heldRodEnd(model, node, end) : -1; r >= 0)
+    {
+      const Rod& rod = model.rods[static_cast<std::size_t>(r)];
+      turned_from_[k] = rod.end_frame[end] * rod.rest_frame.conjugate();
+      moved = true;
+    }
     if (goals_[k])
     {
       state.velocity.col(node) = (*goals_[k] - state.position.col(node)) / dt;
@@ -43,32 +67,54 @@ bool AnchorSet::setVelocities(const Model& model, State& state, double dt) const
   return moved;
 }
 
-void AnchorSet::advance(const Model& model, State& state, double h)
-{
-  for (const Anchor& anchor : model.anchors)
-    state.position.col(anchor.node) += h * state.velocity.col(anchor.node);
-}
-
-void AnchorSet::land(const Model& model, State& state)
+void AnchorSet::advance(Model& model, State& state, int substep, int substeps, double h) const
 {
   for (std::size_t k = 0; k < model.anchors.size(); ++k)
+  {
+    const int node = model.anchors[k].node;
+    state.position.col(node) += h * state.velocity.col(node);
+    int end = 0;
+    if (const int r = turns_[k] ? heldRodEnd(model, node, end) : -1; r >= 0)
+    {
+      Rod& rod = model.rods[static_cast<std::size_t>(r)];
+      rod.end_frame[end] = turned_from_[k].slerp(static_cast<double>(substep) / substeps, *turns_[k]) * rod.rest_frame;
+    }
+  }
+}
+
+void AnchorSet::land(Model& model, State& state)
+{
+  for (std::size_t k = 0; k < model.anchors.size(); ++k)
+  {
     if (goals_[k])
     {
       state.position.col(model.anchors[k].node) = *goals_[k];
       goals_[k].reset();
     }
+    int end = 0;
+    if (const int r = turns_[k] ? heldRodEnd(model, model.anchors[k].node, end) : -1; r >= 0)
+    {
+      Rod& rod = model.rods[static_cast<std::size_t>(r)];
+      rod.end_frame[end] = turns_[k]->normalized() * rod.rest_frame;
+    }
+    turns_[k].reset();
+  }
 }
 
 void AnchorSet::added()
 {
   goals_.emplace_back();
   paths_.emplace_back();
+  turns_.emplace_back();
+  turned_from_.push_back(Eigen::Quaterniond::Identity());
 }
 
 void AnchorSet::removed(std::size_t k)
 {
   goals_.erase(goals_.begin() + static_cast<std::ptrdiff_t>(k));
   paths_.erase(paths_.begin() + static_cast<std::ptrdiff_t>(k));
+  turns_.erase(turns_.begin() + static_cast<std::ptrdiff_t>(k));
+  turned_from_.erase(turned_from_.begin() + static_cast<std::ptrdiff_t>(k));
 }
 
 bool AnchorSet::isAttached(int k) const

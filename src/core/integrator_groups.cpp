@@ -126,6 +126,10 @@ void IntegratorGroups::rebuild(const Model& model)
         m.cells.push_back(model.cells[k]);
         group.cells.push_back(k);
       }
+    m.rods.clear();
+    for (const Rod& rod : model.rods)
+      if (mine(rod.first))
+        m.rods.push_back(rod);
     m.colliders = Colliders{};
     m.contact_segments.clear();
     groups_.push_back(std::move(group));

@@ -169,6 +169,17 @@ World buildWorld(const SceneDef& scene)
                                     "counter-clockwise about its normal) and a positive pressure");
       model.cells.push_back(cell);
     }
+    if (body.rod)
+    {
+      Rod rod = *body.rod;
+      rod.first += first;
+      // An anchor on an end holds its orientation as well as its position: a gripper turns the rod's end.
+      for (const AnchorDef& anchor : body.anchors)
+        for (int end = 0; end < 2; ++end)
+          if (globalIndex(body, first, anchor.node) == (end == 0 ? rod.first : rod.last()))
+            rod.held[end] = true;
+      model.rods.push_back(rod);
+    }
     for (const auto& [a, b] : body.contact_segments)
       model.contact_segments.emplace_back(globalIndex(body, first, a), globalIndex(body, first, b));
     for (const AnchorDef& anchor : body.anchors)
@@ -184,6 +195,10 @@ World buildWorld(const SceneDef& scene)
     model.bodies.push_back({ body.name, first, count, body.self_collision, body.self_friction, body.springs_collide });
     first += count;
   }
+  if (!model.rods.empty() && scene.physics.integrator != IntegratorType::ImplicitEuler)
+    throw std::invalid_argument("physics.integrator: a rod (type: rod) bends and twists only under implicit_euler; "
+                                "the scene asks for " + integratorName(scene.physics.integrator));
+  state.twist.setZero(static_cast<Eigen::Index>(model.rods.size()));
   StepSettings step = scene.physics.step;
   if (scene.physics.auto_dt)
   {

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/rods.h"
 
 namespace soft_body_sim
 {
@@ -71,7 +72,7 @@ bool World::driveKinematicNodes(double dt)
 
 void World::moveHeldNodes(int substep, double h)
 {
-  AnchorSet::advance(model_, state_, h);
+  anchors_.advance(model_, state_, substep, settings_.substeps, h);
   grasps_.advance(state_, substep, settings_.substeps, h);
   integrators_.invalidate();
 }
@@ -294,6 +295,8 @@ NodeArray World::pulls() const
 {
   NodeArray pull;
   internalPulls(model_, state_.position, internalForces(), pull);
+  for (std::size_t r = 0; r < model_.rods.size(); ++r)
+    accumulateRodForces(model_.rods[r], state_.position, rodTwistOf(r), pull);
   return pull;
 }
 
@@ -304,7 +307,14 @@ std::vector<Wrench> World::anchorWrenches() const
     return wrenches;
   const NodeArray pull = pulls();
   for (const Anchor& anchor : model_.anchors)
+  {
     wrenches.push_back(holdingWrench(model_, state_.position, pull, { anchor.node }, state_.position.col(anchor.node)));
+    // A rod's held end takes its bending and twisting moment too.
+    for (std::size_t r = 0; r < model_.rods.size(); ++r)
+      for (int end = 0; end < 2; ++end)
+        if (model_.rods[r].held[end] && anchor.node == (end == 0 ? model_.rods[r].first : model_.rods[r].last()))
+          wrenches.back().torque += heldEndTorque(model_.rods[r], state_.position, rodTwistOf(r), end);
+  }
   return wrenches;
 }
 

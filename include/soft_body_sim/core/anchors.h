@@ -27,19 +27,29 @@ public:
 
   /// Anchor k moves to `position` [m] during the next step; the latest call before a step wins.
   void setGoal(std::size_t k, const Vec3& position) { goals_.at(k) = position; }
+  /// Anchor k also turns to `orientation` (unit; identity = as the scene built it) during the next step, if
+  /// it holds a rod's end (Rod::held): the end's frame becomes orientation * Rod::rest_frame, turning at
+  /// constant angular velocity (slerp) over the step's sub-steps. Other anchors hold no orientation.
+  void setGoal(std::size_t k, const Vec3& position, const Eigen::Quaterniond& orientation)
+  {
+    goals_.at(k) = position;
+    turns_.at(k) = orientation;
+  }
   /// Anchor k follows path(t) every step (an empty path stops it); a goal set for a step overrides it.
   void followPath(std::size_t k, AnchorPath path) { paths_.at(k) = std::move(path); }
 
   /// Stage: the anchors without a goal for the step ending at t [s] take their path's.
   void goalsFromPaths(double t);
   /// Stage: each anchor's node gets the velocity that reaches its goal in dt [s]; one that has arrived
-  /// stands still. True if any anchor node moves or stopped moving.
-  bool setVelocities(const Model& model, State& state, double dt) const;
-  /// Stage, per sub-step of h [s]: every anchor node moves by h v.
-  static void advance(const Model& model, State& state, double h);
+  /// stands still; a turning one notes the orientation it turns from. True if any anchor node moves or
+  /// stopped moving, or turns.
+  bool setVelocities(const Model& model, State& state, double dt);
+  /// Stage, sub-step `substep` (1 to substeps) of h [s]: every anchor node moves by h v; a turning rod end
+  /// turns substep / substeps of its way.
+  void advance(Model& model, State& state, int substep, int substeps, double h) const;
   /// Stage, at the step's end: anchors land exactly on their goals (the sub-step sums differ from them by
   /// round-off), and the goals are used up.
-  void land(const Model& model, State& state);
+  void land(Model& model, State& state);
 
   /// A new anchor was appended to model.anchors (attach).
   void added();
@@ -51,6 +61,9 @@ public:
 private:
   std::vector<std::optional<Vec3>> goals_;  ///< per anchor: where to be at the end of the next step
   std::vector<AnchorPath> paths_;           ///< per anchor: followed every step if set
+  /// per anchor: the orientation to turn to by the end of the next step (rod ends only)
+  std::vector<std::optional<Eigen::Quaterniond>> turns_;
+  std::vector<Eigen::Quaterniond> turned_from_;  ///< per anchor: its orientation when its turn began
   std::size_t scene_anchors_;               ///< anchors [0, scene_anchors_) came with the scene
 };
 

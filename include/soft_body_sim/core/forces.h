@@ -77,7 +77,7 @@ void computeAccelerations(const Model& model, const NodeArray& x, const NodeArra
 
 /// Kinetic [J] of the free nodes.
 double kineticEnergy(const Model& model, const State& state);
-/// Potential [J]: elastic energy of the springs and the cells' gas plus gravitational energy -m g.x
+/// Potential [J]: elastic energy of the springs, the cells' gas and the rods (rodEnergy) plus gravitational energy -m g.x
 /// of the free nodes.
 double potentialEnergy(const Model& model, const State& state);
 

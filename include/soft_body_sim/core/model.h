@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "soft_body_sim/core/colliders.h"
 
@@ -53,6 +54,30 @@ struct PressureCell
   double pressure = 0.0;        ///< p0 [N/m] (2D pressure: force per length of outline), > 0
 };
 
+/// A rod's bending and twisting (a `type: rod` body; rods.h): a discrete elastic rod (Bergou et al. 2008),
+/// isotropic (circular cross-section), straight and untwisted at rest, its nodes first .. first + count - 1
+/// in order. Its stretching is springs of Model::springs. An end is *held* when its node is clamped or
+/// anchored: its position and its orientation belong to the caller, the orientation as `end_frame`.
+/// Material frames: x along the rod (from its first node to its last), y and z across it.
+struct Rod
+{
+  int first = 0;                     ///< global index of its first node
+  int count = 0;                     ///< nodes, >= 2
+  double segment_length = 0.0;       ///< l: every segment's rest length [m], > 0
+  double bending_stiffness = 0.0;    ///< E I [N m^2], > 0
+  double twisting_stiffness = 0.0;   ///< G J [N m^2], > 0
+  double damping = 0.0;              ///< beta [s]: stiffness-proportional damping of its bending (Rayleigh)
+  Eigen::Quaterniond rest_frame = Eigen::Quaterniond::Identity();  ///< every segment's frame at rest
+  bool held[2] = { false, false };   ///< its first / last node holds position and orientation
+  /// The frames of its held ends now (rest_frame until an anchor turns them); unused where not held.
+  Eigen::Quaterniond end_frame[2] = { Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity() };
+
+  int last() const { return first + count - 1; }
+  double restLength() const { return segment_length * (count - 1); }
+  /// True when both ends are held: only then does it store twist (a free end lets it unwind).
+  bool twists() const { return held[0] && held[1]; }
+};
+
 /// A named run of consecutive nodes: the scene's bodies share one node array.
 struct BodyRange
 {
@@ -89,6 +114,7 @@ struct Model
   std::vector<Spring> springs;
   std::vector<DistanceConstraint> constraints;
   std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then
+  std::vector<Rod> rods;            ///< empty unless a scene has rods: no bending or twist pass then
   std::vector<BodyRange> bodies;
   Colliders colliders;  ///< as the scene declares them; the contact stage prepares its own copies
   std::vector<Anchor> anchors;
@@ -112,6 +138,9 @@ struct State
 {
   NodeArray position;  ///< [m]
   NodeArray velocity;  ///< [m/s]
+  /// [rad] per rod of Model::rods: its total twist between its held ends (rods.h), counted on through
+  /// whole turns; 0 for a rod that does not twist (Rod::twists).
+  Eigen::VectorXd twist;
 };
 
 /// How a step is taken: the world advances dt per step in `substeps` equal sub-steps.

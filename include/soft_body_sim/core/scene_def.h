@@ -91,6 +91,9 @@ struct BodyDef
   /// With self_collision: its springs too are capsules of its contact radius, which its own nodes stay
   /// out of (a jelly: no node crosses a spring).
   bool springs_collide = false;
+  /// A rod's bending and twisting over all its nodes in order (a `type: rod` body, bodies/rod.h), its
+  /// first node 0 of the body; empty for every other body.
+  std::optional<Rod> rod;
 };
 
 /// The checks of a body type's self-contact keys (rope, cloth, jelly), for its builder: self_friction

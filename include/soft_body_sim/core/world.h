@@ -73,6 +73,13 @@ public:
   /// Moves the anchor's (pinned) node to `position` [m] during the next step, at constant velocity,
   /// so that springs and dashpots feel a smooth motion. The latest call before a step wins.
   void moveAnchor(int anchor, const Vec3& position) { anchors_.setGoal(static_cast<std::size_t>(anchor), position); }
+  /// moveAnchor, and an anchor holding a rod's end also turns it to `orientation` (identity: as built;
+  /// AnchorSet::setGoal), at constant angular velocity the shorter way round: to turn an end further than
+  /// half a turn, turn it over several steps (the rod counts the whole turns of its twist).
+  void moveAnchor(int anchor, const Vec3& position, const Eigen::Quaterniond& orientation)
+  {
+    anchors_.setGoal(static_cast<std::size_t>(anchor), position, orientation);
+  }
   /// Sets the target [m] of body `body` (creature, humanoid); false if it has none or is unknown.
   bool setTarget(const std::string& body, const Vec3& target);
   /// True if body `body` (index into model().bodies) takes a target.
@@ -149,7 +156,8 @@ public:
   /// Each link's tension [N] in the last sub-step, > 0 stretched: springs, then constraints, in model
   /// order (internalForces().tension).
   Eigen::VectorXd linkTensions() const { return internalForces().tension; }
-  /// Per anchor of model().anchors, the wrench its body exerts on it, torque about its node.
+  /// Per anchor of model().anchors, the wrench its body exerts on it, torque about its node (a rod's held
+  /// end: its bending and twisting moment, heldEndTorque).
   std::vector<Wrench> anchorWrenches() const;
   /// Per grasp of grasps(), the wrench its body exerts on it, torque about its frame's origin.
   std::vector<Wrench> graspWrenches() const;
@@ -190,6 +198,12 @@ private:
   std::string treatDiverged(std::size_t body);
   /// Per node, the internal forces on it (internalPulls).
   NodeArray pulls() const;
+  /// Rod r's total twist [rad] (State::twist; 0 before its first step).
+  double rodTwistOf(std::size_t r) const
+  {
+    const Eigen::Index k = static_cast<Eigen::Index>(r);
+    return k < state_.twist.size() ? state_.twist[k] : 0.0;
+  }
   /// The model's parameters or pinning changed: the integrators drop their caches.
   void modelChanged() { integrators_.modelChanged(); }
 

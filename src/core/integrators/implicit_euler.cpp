@@ -11,6 +11,7 @@
 #include "integrator_kit.h"
 #include "sparse_block_solver.h"
 #include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/rods.h"
 
 namespace soft_body_sim
 {
@@ -36,7 +37,14 @@ using Matrix3 = Eigen::Matrix3d;
 /// dropping p d^2A/dx_k dx_l, which is indefinite (A is bilinear in the positions) and vanishes at
 /// rest; the kept part is the one that stiffens without bound as the cell is squeezed.
 ///
-/// A spring's 3x3 block is a u u^T + b I (below), a cell's h^2 S g_k g_l^T. The matrix's pattern (which
+/// Rods (rods.h) enter f with their bending force -2 w J_k^T kb at each vertex (J_k = dkb/dx_k of its
+/// three nodes, w its weight) and K with its Gauss-Newton part -2 w J_k^T J_l, dropping 2 w kb . d^2kb,
+/// which vanishes straight and keeps K symmetric negative semi-definite; the damping -beta K v
+/// (Rod::damping) enters D. Their twist's force -(G J twist / L) d(twist)/dx enters f only, explicitly:
+/// its stiffness is rank one and couples every node of the rod (a dense block), and against the bending's
+/// it is of order M_t l / (E I) for a twisting moment M_t, l / L near the critical twist of a long rod.
+/// A spring's 3x3 block is a u u^T + b I (below), a cell's h^2 S g_k g_l^T, a rod vertex's
+/// (h^2 + h beta) 2 w J_k^T J_l. The matrix's pattern (which
 /// node pairs couple) depends only on the springs, the cells and which nodes are pinned: it is analysed
 /// on the first step and after every model change, and each Newton iteration only writes its values and
 /// factorises. Every array is sized once: a step allocates nothing after the first.
@@ -52,6 +60,11 @@ public:
     const int n = model.nodeCount();
     start_x_ = state.position;
     start_v_ = state.velocity;
+    if (state.twist.size() != static_cast<Eigen::Index>(model.rods.size()))
+      state.twist.setZero(static_cast<Eigen::Index>(model.rods.size()));
+    twist_ = &state.twist;
+    if (!analyzed_)
+      analyze(model);
     for (int k = 0; k < iterations; ++k)
     {
       const NodeArray& v_k = state.velocity;
@@ -79,6 +92,9 @@ public:
       if (model.isFree(i))
         state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
     constraints_.apply(model, state, h, iterations);
+    for (std::size_t r = 0; r < model.rods.size(); ++r)
+      state.twist[static_cast<Eigen::Index>(r)] =
+          rodTwist(model.rods[r], state.position, state.twist[static_cast<Eigen::Index>(r)]);
   }
 
 private:
@@ -96,6 +112,15 @@ private:
   {
     Vec3 g[4];
     double scale;  ///< h^2 S [N/m^3 s^2]
+  };
+
+  /// A rod vertex's blocks (h^2 + h beta) 2 w J_k^T J_l: its three nodes (before, at, after; -1 where the
+  /// edge is a held end's ghost or the node is pinned) and their Jacobians J_k = dkb/dx_k.
+  struct RodBlock
+  {
+    int nodes[3];
+    Matrix3 jacobian[3];
+    double scale;  ///< (h^2 + h beta) 2 w [N m^3 s^2]
   };
 
   /// Fills the blocks of A = M - h D - h^2 K and rhs_ (see the class comment) at (x, v).
@@ -188,6 +213,66 @@ private:
     cells_.resize(model.cells.size());
     for (std::size_t k = 0; k < model.cells.size(); ++k)
       addCell(model, model.cells[k], x, h, cells_[k]);
+    if (!model.rods.empty())
+      addRods(model, x, v, h);
+  }
+
+  /// The rods' bending blocks (on the diagonal here; off it in multiply and solveDirectly) and their
+  /// bending, damping and twist forces in rhs_: per vertex, with q = sum_l J_l offset_l and
+  /// r = sum_l J_l v_l, rhs_k -= 2 w h J_k^T (kb + q + beta r); per rod that twists,
+  /// rhs_i -= h (G J twist / L) d(twist)/dx_i.
+  void addRods(const Model& model, const NodeArray& x, const NodeArray& v, double h)
+  {
+    rod_blocks_.resize(rod_vertices_.size());
+    for (std::size_t k = 0; k < rod_vertices_.size(); ++k)
+    {
+      const RodVertex& vertex = rod_vertices_[k];
+      const Rod& rod = model.rods[static_cast<std::size_t>(rod_of_vertex_[k])];
+      Vec3 e0, e1;
+      vertexEdges(rod, vertex, x, e0, e1);
+      const CurvatureBinormal bend = curvatureBinormal(e0, e1, rod.segment_length * rod.segment_length);
+      RodBlock& block = rod_blocks_[k];
+      // x_before enters e0 negatively, x_at e0 positively and e1 negatively, x_after e1 positively.
+      block.nodes[0] = vertex.before;
+      block.nodes[1] = vertex.at;
+      block.nodes[2] = vertex.after;
+      block.jacobian[0] = -bend.d_e0;
+      block.jacobian[1] = (vertex.before < 0 ? Matrix3::Zero() : bend.d_e0) - (vertex.after < 0 ? Matrix3::Zero() : bend.d_e1);
+      block.jacobian[2] = bend.d_e1;
+      block.scale = 2.0 * vertex.weight * (h * h + h * rod.damping);
+      Vec3 q = Vec3::Zero(), r = Vec3::Zero();
+      for (int c = 0; c < 3; ++c)
+      {
+        if (block.nodes[c] < 0 || !model.isFree(block.nodes[c]))
+        {
+          block.nodes[c] = -1;
+          continue;
+        }
+        q += block.jacobian[c] * offset_.col(block.nodes[c]);
+        r += block.jacobian[c] * v.col(block.nodes[c]);
+      }
+      const Vec3 pull = 2.0 * vertex.weight * h * (bend.kb + q + rod.damping * r);
+      for (int c = 0; c < 3; ++c)
+      {
+        const int node = block.nodes[c];
+        if (node < 0)
+          continue;
+        rhs_.col(node) -= block.jacobian[c].transpose() * pull;
+        diagonal_[static_cast<std::size_t>(node)] += block.scale * block.jacobian[c].transpose() * block.jacobian[c];
+      }
+    }
+    for (std::size_t r = 0; r < model.rods.size(); ++r)
+    {
+      const Rod& rod = model.rods[r];
+      if (!rod.twists())
+        continue;
+      const double twist = rodTwist(rod, x, (*twist_)[static_cast<Eigen::Index>(r)]);
+      rodTwistGradient(rod, x, twist_gradient_);
+      const double moment = rod.twisting_stiffness * twist / rod.restLength();
+      for (int j = 0; j < rod.count; ++j)
+        if (model.isFree(rod.first + j))
+          rhs_.col(rod.first + j) -= h * moment * twist_gradient_.col(j);
+    }
   }
 
   /// Block Jacobi for conjugate gradients: the inverse of each node's full 3x3 diagonal block (springs'
@@ -257,6 +342,17 @@ private:
       for (int l = 0; l < 4; ++l)
         out.col(cell.nodes[l]) += (block.scale * g_dot_p) * block.g[l];
     }
+    for (const RodBlock& block : rod_blocks_)
+      for (int c = 0; c < 3; ++c)
+      {
+        if (block.nodes[c] < 0)
+          continue;
+        Vec3 j_p = Vec3::Zero();  // sum over the vertex's other nodes of J_l p_l
+        for (int l = 0; l < 3; ++l)
+          if (l != c && block.nodes[l] >= 0)
+            j_p += block.jacobian[l] * p.col(block.nodes[l]);
+        out.col(block.nodes[c]) += block.scale * (block.jacobian[c].transpose() * j_p);
+      }
   }
 
   void precondition(const NodeArray& r, NodeArray& z) const
@@ -335,6 +431,28 @@ private:
           pairs.emplace_back(a, b);
         }
       }
+    rod_vertices_.clear();
+    rod_of_vertex_.clear();
+    for (std::size_t r = 0; r < model.rods.size(); ++r)
+    {
+      appendRodVertices(model.rods[r], rod_vertices_);
+      rod_of_vertex_.resize(rod_vertices_.size(), static_cast<int>(r));
+    }
+    rod_slot_.assign(3 * rod_vertices_.size(), -1);
+    for (std::size_t k = 0; k < rod_vertices_.size(); ++k)
+    {
+      const RodVertex& vertex = rod_vertices_[k];
+      const int nodes[3] = { vertex.before, vertex.at, vertex.after };
+      for (std::size_t p = 0; p < kRodPairs.size(); ++p)
+      {
+        const int a = nodes[kRodPairs[p].first], b = nodes[kRodPairs[p].second];
+        if (a >= 0 && b >= 0 && model.isFree(a) && model.isFree(b))
+        {
+          rod_slot_[3 * k + p] = static_cast<int>(pairs.size());
+          pairs.emplace_back(a, b);
+        }
+      }
+    }
     chains_ = linear_solve_ != LinearSolve::Iterative && chain_solver_.analyze(model.nodeCount(), pairs);
     factorable_ = chains_ || (linear_solve_ != LinearSolve::Iterative &&
                               solver_.analyze(model.nodeCount(), pairs,
@@ -392,6 +510,15 @@ private:
           solver.addOffDiagonal(static_cast<std::size_t>(cell_slot_[6 * k + p]),
                                 block.scale * block.g[kCellPairs[p].first] * block.g[kCellPairs[p].second].transpose());
     }
+    for (std::size_t k = 0; k < rod_blocks_.size(); ++k)
+    {
+      const RodBlock& block = rod_blocks_[k];
+      for (std::size_t p = 0; p < kRodPairs.size(); ++p)
+        if (rod_slot_[3 * k + p] >= 0)
+          solver.addOffDiagonal(static_cast<std::size_t>(rod_slot_[3 * k + p]),
+                                block.scale * block.jacobian[kRodPairs[p].first].transpose() *
+                                    block.jacobian[kRodPairs[p].second]);
+    }
     // A is symmetric positive definite by construction (the transverse stiffness of compressed springs
     // and the indefinite part of the gas's Hessian are dropped, see above), unless the state is not
     // finite: then the step is not finite either, and the divergence guard (guard.h) takes it.
@@ -422,6 +549,9 @@ private:
   /// The six pairs of a cell's four corners.
   static constexpr std::array<std::pair<int, int>, 6> kCellPairs{ { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } } };
 
+  /// The three node pairs of a rod vertex (before, at, after).
+  static constexpr std::array<std::pair<int, int>, 3> kRodPairs{ { { 0, 1 }, { 0, 2 }, { 1, 2 } } };
+
   NodeArray start_x_, start_v_, linear_x_, offset_;
   NodeArray force_;  ///< the cells' pressure forces [N]
   NodeArray rhs_, delta_v_;
@@ -441,6 +571,12 @@ private:
   double condition_ = 1.0;         ///< estimate of block-Jacobi preconditioned A's condition number
   std::vector<int> spring_slot_;   ///< per spring: its slot in solver_, or -1 (not coupled)
   std::vector<int> cell_slot_;     ///< per cell, six: each corner pair's slot, or -1
+  std::vector<RodVertex> rod_vertices_;  ///< every rod's bending vertices (appendRodVertices)
+  std::vector<int> rod_of_vertex_;       ///< per rod vertex: its rod's index in Model::rods
+  std::vector<RodBlock> rod_blocks_;     ///< per rod vertex
+  std::vector<int> rod_slot_;            ///< per rod vertex, three: each node pair's slot, or -1
+  NodeArray twist_gradient_;             ///< d(twist)/dx of one rod (rodTwistGradient)
+  const Eigen::VectorXd* twist_ = nullptr;  ///< the state's twists during a step
 };
 }  // namespace
 
