@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "soft_body_sim/core/bodies/humanoid.h"
+#include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/mesh_field.h"
 #include "soft_body_sim/ros/ros_converter.h"
@@ -315,6 +316,69 @@ TEST(RosConverter, APositionGoesIntoAPoseWithTheIdentityOrientationAndBack)
   translation.y = 4.0;
   translation.z = -5.0;
   EXPECT_EQ(RosConverter::toVec3(translation), Vec3(3.0, 4.0, -5.0));
+}
+
+TEST(RosConverter, APoseGivesAnOrientationMadeUnitOrNoneWhenItIsAllZeros)
+{
+  geometry_msgs::Pose pose = RosConverter::toPose(Vec3(1.0, 2.0, 3.0));
+  pose.orientation.x = 2.0;
+  pose.orientation.w = 0.0;
+  Vec3 position;
+  std::optional<Eigen::Quaterniond> orientation;
+  std::string why;
+  ASSERT_TRUE(RosConverter::fromPose(pose, position, orientation, why));
+  ASSERT_TRUE(orientation);
+  EXPECT_TRUE(orientation->isApprox(Eigen::Quaterniond(0.0, 1.0, 0.0, 0.0), 1e-15));
+  pose.orientation.x = 0.0;  // all zeros: a message that sets only a position
+  ASSERT_TRUE(RosConverter::fromPose(pose, position, orientation, why));
+  EXPECT_FALSE(orientation);
+  EXPECT_EQ(position, Vec3(1.0, 2.0, 3.0));
+}
+
+TEST(RosConverter, ARodIsAStripOfItsDiameterWithItsSegmentsFramesTurnedByItsTwist)
+{
+  // A weightless rod along x, clamped at its first node, its last turned a quarter turn about x.
+  RodDef def;
+  def.nodes = 11;
+  def.from = Vec3::Zero();
+  def.to = Vec3(1.0, 0.0, 0.0);
+  def.radius = 0.01;
+  def.clamped = { 0 };
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.gravity = Vec3::Zero();
+  scene.bodies.push_back(buildRod("cable", def));
+  scene.bodies[0].anchors.push_back(AnchorDef("tip", 10));
+  World world = buildWorld(scene);
+  for (int k = 1; k <= 10; ++k)
+  {
+    world.moveAnchor(0, Vec3(1.0, 0.0, 0.0), Eigen::Quaterniond(Eigen::AngleAxisd(0.1 * M_PI / 2 * k, Vec3::UnitX())));
+    world.step();
+  }
+  const visualization_msgs::MarkerArray array = RosConverter::toMarkers(world, "map", ros::Time(1.0));
+  const visualization_msgs::Marker* strip = nullptr;
+  const visualization_msgs::Marker* axes = nullptr;
+  for (const visualization_msgs::Marker& m : array.markers)
+  {
+    if (m.ns == "cable" && m.type == visualization_msgs::Marker::LINE_STRIP)
+      strip = &m;
+    if (m.ns == "cable/frames")
+      axes = &m;
+  }
+  ASSERT_TRUE(strip && axes);
+  EXPECT_EQ(strip->points.size(), 11u);
+  EXPECT_DOUBLE_EQ(strip->scale.x, 0.02);
+  ASSERT_EQ(axes->points.size(), 10u * 6u);  // per segment: x, y and z from its midpoint
+  ASSERT_EQ(axes->colors.size(), axes->points.size());
+  // Segment j's y axis (points 6 j + 2, 6 j + 3) is turned about x by (j + 1/2) / 10 of the quarter turn.
+  for (int j = 0; j < 10; ++j)
+  {
+    const geometry_msgs::Point& from = axes->points[static_cast<std::size_t>(6 * j + 2)];
+    const geometry_msgs::Point& to = axes->points[static_cast<std::size_t>(6 * j + 3)];
+    const double angle = std::atan2(to.z - from.z, to.y - from.y);
+    EXPECT_NEAR(angle, M_PI / 2 * (j + 0.5) / 10, 1e-9) << "segment " << j;
+    EXPECT_EQ(axes->colors[static_cast<std::size_t>(6 * j + 2)].g, 1.0f);
+  }
 }
 
 TEST(RosConverter, TheLivePhysicsGoIntoTheReconfigureConfigAndBack)

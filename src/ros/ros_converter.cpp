@@ -1,6 +1,9 @@
 #include "soft_body_sim/ros/ros_converter.h"
 
+#include <algorithm>
 #include <cmath>
+
+#include "soft_body_sim/core/rods.h"
 
 namespace soft_body_sim
 {
@@ -131,6 +134,63 @@ geometry_msgs::Vector3 vector3(const Vec3& v)
 
 }  // namespace
 
+namespace
+{
+/// Each rod as a LINE_STRIP of its diameter (id 2 in its body's namespace) and, in the namespace
+/// "<body>/frames" (which rviz can hide on its own), each segment's material frame as three short lines
+/// from its midpoint, red x along the rod, green y, blue z: a twist shows as the green and blue lines
+/// turning about the rod.
+void addRodMarkers(const World& world, const std::string& frame_id, const ros::Time& stamp,
+                   visualization_msgs::MarkerArray& array)
+{
+  const Model& model = world.model();
+  const NodeArray& x = world.state().position;
+  std::vector<Eigen::Quaterniond> frames;
+  for (std::size_t r = 0; r < model.rods.size(); ++r)
+  {
+    const Rod& rod = model.rods[r];
+    const std::size_t b = model.bodyOf(rod.first);
+    const std::string& name = model.bodies[b].name;
+    visualization_msgs::Marker strip = marker(frame_id, stamp, name, 2, visualization_msgs::Marker::LINE_STRIP,
+                                              2.0 * model.contact_radius[rod.first], bodyColor(b));
+    visualization_msgs::Marker axes =
+        marker(frame_id, stamp, name + "/frames", 0, visualization_msgs::Marker::LINE_LIST, 0.5 * kLineWidth, bodyColor(b));
+    const Eigen::Index k = static_cast<Eigen::Index>(r);
+    rodFrames(rod, x, k < world.state().twist.size() ? world.state().twist[k] : 0.0, frames);
+    const double length = 0.8 * rod.segment_length;
+    for (int j = 0; j < rod.count; ++j)
+    {
+      const Vec3 p = x.col(rod.first + j);
+      if (!p.allFinite())
+        continue;
+      strip.points.push_back(point(p));
+      if (j + 1 == rod.count || !x.col(rod.first + j + 1).allFinite())
+        continue;
+      const Vec3 middle = 0.5 * (p + x.col(rod.first + j + 1));
+      const Eigen::Matrix3d axis = frames[static_cast<std::size_t>(j)].toRotationMatrix();
+      for (int c = 0; c < 3; ++c)
+      {
+        std_msgs::ColorRGBA color;
+        color.r = c == 0 ? 1.0f : 0.0f;
+        color.g = c == 1 ? 1.0f : 0.0f;
+        color.b = c == 2 ? 1.0f : 0.0f;
+        color.a = 1.0f;
+        axes.points.push_back(point(middle));
+        axes.points.push_back(point(middle + length * axis.col(c)));
+        axes.colors.push_back(color);
+        axes.colors.push_back(color);
+      }
+    }
+    for (visualization_msgs::Marker* m : { &strip, &axes })
+    {
+      if (m->points.empty())
+        m->action = visualization_msgs::Marker::DELETE;
+      array.markers.push_back(*m);
+    }
+  }
+}
+}  // namespace
+
 visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, const std::string& frame_id,
                                                         const ros::Time& stamp)
 {
@@ -144,21 +204,26 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
     const std_msgs::ColorRGBA color = bodyColor(b);
     visualization_msgs::Marker nodes =
         marker(frame_id, stamp, body.name, 0, visualization_msgs::Marker::SPHERE_LIST, kNodeDiameter, color);
+    // A rod is drawn as itself (addRodMarkers): no node balls, no link lines.
+    const bool rod = std::any_of(model.rods.begin(), model.rods.end(), [&](const Rod& r) { return r.first == body.first; });
     for (int i = body.first; i < body.first + body.count; ++i)
     {
-      body_of_node[static_cast<std::size_t>(i)] = static_cast<int>(b);
-      if (x.col(i).allFinite())
+      body_of_node[static_cast<std::size_t>(i)] = rod ? -1 : static_cast<int>(b);
+      if (!rod && x.col(i).allFinite())
         nodes.points.push_back(point(x.col(i)));
     }
     array.markers.push_back(nodes);
     array.markers.push_back(
         marker(frame_id, stamp, body.name, 1, visualization_msgs::Marker::LINE_LIST, kLineWidth, color));
   }
-  // Springs and constraints join nodes of one body; each goes to that body's LINE_LIST (index 2b + 1).
+  // Springs and constraints join nodes of one body; each goes to that body's LINE_LIST (index 2b + 1),
+  // but a rod's (body_of_node -1).
   for (const Spring& s : model.springs)
-    addSegment(x, s.a, s.b, array.markers[2 * static_cast<std::size_t>(body_of_node[s.a]) + 1]);
+    if (body_of_node[static_cast<std::size_t>(s.a)] >= 0)
+      addSegment(x, s.a, s.b, array.markers[2 * static_cast<std::size_t>(body_of_node[s.a]) + 1]);
   for (const DistanceConstraint& c : model.constraints)
-    addSegment(x, c.a, c.b, array.markers[2 * static_cast<std::size_t>(body_of_node[c.a]) + 1]);
+    if (body_of_node[static_cast<std::size_t>(c.a)] >= 0)
+      addSegment(x, c.a, c.b, array.markers[2 * static_cast<std::size_t>(body_of_node[c.a]) + 1]);
 
   // rviz rejects list markers without points; an empty one is sent as DELETE, which also clears a
   // marker that once had points.
@@ -180,6 +245,7 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
       array.markers.push_back(strip);
     }
   }
+  addRodMarkers(world, frame_id, stamp, array);
   addColliderMarkers(world, frame_id, stamp, array);
   return array;
 }
@@ -309,6 +375,18 @@ bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position, std
     return false;
   }
   position = p;
+  return true;
+}
+
+bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position,
+                            std::optional<Eigen::Quaterniond>& orientation, std::string& why)
+{
+  if (!fromPose(pose, position, why))
+    return false;
+  const Eigen::Quaterniond q(pose.orientation.w, pose.orientation.x, pose.orientation.y, pose.orientation.z);
+  orientation.reset();
+  if (q.norm() > 1e-12)
+    orientation = q.normalized();
   return true;
 }
 

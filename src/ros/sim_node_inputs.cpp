@@ -96,7 +96,7 @@ void SimNode::subscribeInputs()
           ScheduledInput input;
           input.kind = ScheduledInput::Kind::Anchor;
           input.anchor = id;
-          if (toSceneFrame(*pose, topic, input.position))
+          if (toSceneFrame(*pose, topic, input.position, &input.orientation))
             schedule(topic, pose->header.stamp, input);
         }));
   }
@@ -173,7 +173,10 @@ void SimNode::applyDueInputs(const ros::Time& step_end)
   {
     if (input.kind == ScheduledInput::Kind::Anchor)
     {
-      world_->moveAnchor(input.anchor, input.position);
+      if (input.orientation)
+        world_->moveAnchor(input.anchor, input.position, *input.orientation);
+      else
+        world_->moveAnchor(input.anchor, input.position);
       continue;
     }
     world_->setTarget(input.body, input.position);
@@ -189,10 +192,13 @@ void SimNode::applyDueInputs(const ros::Time& step_end)
   }
 }
 
-bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position)
+bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position,
+                           std::optional<Eigen::Quaterniond>* orientation)
 {
   std::string why;
-  if (!RosConverter::fromPose(pose.pose, position, why))
+  std::optional<Eigen::Quaterniond> unused;
+  std::optional<Eigen::Quaterniond>& turn = orientation ? *orientation : unused;
+  if (!RosConverter::fromPose(pose.pose, position, turn, why))
   {
     ROS_WARN_THROTTLE(5.0, "%s: pose dropped: %s", topic.c_str(), why.c_str());
     return false;
@@ -224,7 +230,9 @@ bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::st
       latest.header.stamp = ros::Time(0);
       tf_buffer_.transform(latest, in_scene, scene_.frame_id);
     }
-    if (!RosConverter::fromPose(in_scene.pose, position, why))
+    if (!turn)
+      in_scene.pose.orientation = pose.pose.orientation;  // all zeros: no orientation given, none to transform
+    if (!RosConverter::fromPose(in_scene.pose, position, turn, why))
     {
       ROS_WARN_THROTTLE(5.0, "%s: pose dropped after the transform to '%s': %s", topic.c_str(),
                         scene_.frame_id.c_str(), why.c_str());

@@ -99,6 +99,7 @@ Keys withCommonBodyKeys(const Keys& own);
 
 BodyDef readCustomBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 BodyDef readRopeBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
+BodyDef readRodBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 BodyDef readClothBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 BodyDef readJellyBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 

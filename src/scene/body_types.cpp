@@ -7,6 +7,7 @@ const std::vector<BodyType>& bodyTypes()
   static const std::vector<BodyType> types = {
     { "custom", readCustomBody },
     { "rope", readRopeBody },
+    { "rod", readRodBody },
     { "cloth", readClothBody },
     { "jelly", readJellyBody },
     { "creature", readCreatureBody },

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <tuple>
 #include <utility>
@@ -40,6 +41,9 @@ struct ScheduledInput
   int anchor = 0;          ///< index into Model::anchors (Kind::Anchor)
   std::string body;        ///< body name (Kind::Target)
   Vec3 position = Vec3::Zero();  ///< [m] in the scene frame
+  /// Kind::Anchor: the orientation in the scene frame (turns an anchor holding a rod's end); none: it keeps
+  /// its orientation.
+  std::optional<Eigen::Quaterniond> orientation;
 };
 
 /// The bounds of InputSchedule (the node's ~max_input_age, ~max_input_lead, ~max_held_inputs).

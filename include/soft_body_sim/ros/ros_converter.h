@@ -68,6 +68,10 @@ public:
 
   /// The position [m] of a pose; false (and why) if any field of the pose is NaN or infinite.
   static bool fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why);
+  /// fromPose, and its orientation made unit, or nullopt when it is all zeros (a message that sets only a
+  /// position: an anchor holding a rod's end then keeps its orientation).
+  static bool fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::optional<Eigen::Quaterniond>& orientation,
+                       std::string& why);
 
   /// A pose at `position` [m] with the identity orientation (anchors and handles have no orientation).
   static geometry_msgs::Pose toPose(const Vec3& position);

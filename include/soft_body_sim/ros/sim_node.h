@@ -71,9 +71,11 @@ private:
   /// warning naming `topic` (stale, too far ahead); warns when its source was full.
   void schedule(const std::string& topic, const ros::Time& stamp, const ScheduledInput& input);
   void applyDueInputs(const ros::Time& step_end);
-  /// The pose's position in the scene frame; false (with a throttled warning naming `topic` and the
-  /// reason) if it is not finite or its frame cannot be transformed.
-  bool toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position);
+  /// The pose's position in the scene frame, and if `orientation` is given its orientation there (nullopt
+  /// when the message's is all zeros, RosConverter::fromPose); false (with a throttled warning naming
+  /// `topic` and the reason) if it is not finite or its frame cannot be transformed.
+  bool toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position,
+                    std::optional<Eigen::Quaterniond>* orientation = nullptr);
   /// The pose of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf has
   /// none that recent yet); nullopt with a throttled warning if tf has none at all.
   std::optional<RigidPose> framePose(const std::string& frame, const ros::Time& stamp);

@@ -1,0 +1,30 @@
+// `type: rod`: a cable, hose or wire by its material (bodies/rod.h), straight from `from` to `to`.
+#include "generated_body_keys.h"
+#include "soft_body_sim/core/bodies/rod.h"
+
+namespace soft_body_sim::scene_yaml
+{
+BodyDef readRodBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
+{
+  requireMap(ctx, field, withCommonBodyKeys({ "nodes", "from", "to", "radius", "youngs_modulus", "shear_modulus",
+                                              "density", "damping", "clamped", "self_collision", "self_friction" }));
+  RodDef rod;
+  const Field nodes = requiredKey(ctx, field, "nodes");
+  rod.nodes = readCount(ctx, nodes, 2);
+  scene.requireNodes(ctx, nodes, rod.nodes);
+  rod.from = readVec3(ctx, requiredKey(ctx, field, "from"));
+  rod.to = readVec3(ctx, requiredKey(ctx, field, "to"));
+  rod.radius = readNumber(ctx, requiredKey(ctx, field, "radius"));
+  rod.youngs_modulus = readNumber(ctx, requiredKey(ctx, field, "youngs_modulus"));
+  if (const std::optional<Field> value = optionalKey(field, "shear_modulus"))
+    rod.shear_modulus = readNumber(ctx, *value);
+  rod.density = readNumber(ctx, requiredKey(ctx, field, "density"));
+  if (const std::optional<Field> value = optionalKey(field, "damping"))
+    rod.damping = readNumber(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "clamped"))
+    rod.clamped = readPinned(ctx, *value, rod.nodes);
+  readSelfContact(ctx, field, rod);
+  return buildBody(ctx, field, rod, buildRod);
+}
+
+}  // namespace soft_body_sim::scene_yaml
