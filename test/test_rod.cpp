@@ -371,4 +371,20 @@ TEST(RodCantilever, AFullCircleTakesTheMomentTwoPiEIOverL)
   EXPECT_EQ(rod.world->divergenceCount(), 0);
 }
 
+TEST(RodContact, ARodDroppedOnTheFloorRestsOnItsRadius)
+{
+  // The cable of config/scenes/cable.yaml, free, dropped level from 10 cm onto a floor with friction.
+  RodDef def = cantilever(41, 5.0e7, 1500.0);
+  def.clamped.clear();
+  def.from = Vec3(-0.5, 0.0, 0.1);
+  def.to = Vec3(0.5, 0.0, 0.1);
+  SceneDef scene = rodScene(def, 0.002);
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  World world = buildWorld(scene);
+  ASSERT_TRUE(settle(world, 1e-6, 20000));
+  for (int i = 0; i < def.nodes; ++i)
+    EXPECT_NEAR(world.state().position(2, i), def.radius, 1e-6) << "node " << i;
+  EXPECT_EQ(world.divergenceCount(), 0);
+}
+
 }  // namespace soft_body_sim::test

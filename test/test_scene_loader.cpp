@@ -942,6 +942,9 @@ const OverBudget kOverBudget[] = {
     "{name: b, type: jelly, nx: 1, ny: 1, top_left: [0, 0, 1], top_right: [1, 0, 1], bottom_left: [0, 0, 0], "
     "mass: 1, edges: {stiffness: 1}, diagonals: {stiffness: 1}, pressure: 1}",
     "bad.yaml:3: bodies[1].ny" },
+  { "Rod", "{name: b, type: rod, nodes: 3, from: [0, 0, 0], to: [1, 0, 0], radius: 0.01, youngs_modulus: 1e9, "
+          "density: 1000}",
+    "bad.yaml:3: bodies[1].nodes" },
   { "Creature", "{name: b, type: creature}", "bad.yaml:3: bodies[1]" },
   { "CreatureTendrils", "{name: b, type: creature, tendrils: {segments: 1}}",
     "bad.yaml:3: bodies[1].tendrils.segments" },
@@ -1376,6 +1379,59 @@ TEST(SceneLoader, MissingFileCannotBeOpened)
   {
     EXPECT_EQ(std::string(e.what()), path + ": cannot open scene file");
   }
+}
+
+TEST(SceneLoader, ARodIsReadByItsMaterial)
+{
+  const SceneDef scene = parseScene(R"(physics: {integrator: implicit_euler}
+bodies:
+  - name: cable
+    type: rod
+    nodes: 5
+    from: [0, 0, 1]
+    to: [1, 0, 1]
+    radius: 0.01
+    youngs_modulus: 2.0e9
+    density: 1000.0
+    damping: 0.01
+    clamped: [0]
+    anchors: [{name: tip, node: -1}]
+)",
+                                     "cable.yaml");
+  const World world = buildWorld(scene);
+  ASSERT_EQ(world.model().rods.size(), 1u);
+  const Rod& rod = world.model().rods[0];
+  const double second_moment = M_PI * std::pow(0.01, 4) / 4.0;
+  EXPECT_DOUBLE_EQ(rod.bending_stiffness, 2.0e9 * second_moment);
+  EXPECT_DOUBLE_EQ(rod.twisting_stiffness, 2.0e9 / 2.6 * 2.0 * second_moment);  // G defaults to E / 2.6
+  EXPECT_DOUBLE_EQ(rod.segment_length, 0.25);
+  EXPECT_TRUE(rod.held[0] && rod.held[1]);  // clamped, and anchored at its last node
+  EXPECT_DOUBLE_EQ(world.model().springs[0].stiffness, 2.0e9 * M_PI * 0.01 * 0.01 / 0.25);
+  EXPECT_DOUBLE_EQ(world.model().mass[0], 0.5 * 1000.0 * M_PI * 0.01 * 0.01 * 0.25);
+  EXPECT_DOUBLE_EQ(world.model().contact_radius[2], 0.01);
+}
+
+TEST(SceneLoader, ARodsMistakesAreNamedAtTheirKeys)
+{
+  const std::string rod = "{name: c, type: rod, nodes: 5, from: [0, 0, 1], to: [1, 0, 1], radius: 0.01, "
+                          "youngs_modulus: 1e9, density: 1000";
+  expectSceneError("bodies:\n  - " + rod + ", clamped: [2]}\n", "bad.yaml:2: bodies[0].clamped",
+                   { "not an end", "grasp" });
+  expectSceneError("bodies:\n  - " + rod + ", shear_modulus: 0}\n", "bad.yaml:2: bodies[0].shear_modulus", { "> 0" });
+  expectSceneError("bodies:\n  - " + rod + ", pinned: [0]}\n", "bad.yaml:2: bodies[0].pinned", {});
+  // Only implicit_euler bends and twists a rod: another integrator is refused, not silently a spring chain.
+  try
+  {
+    buildWorld(parseScene("physics: {integrator: xpbd}\nbodies:\n  - " + rod + "}\n", "bad.yaml"));
+    ADD_FAILURE() << "built a rod under xpbd";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("implicit_euler"), std::string::npos) << e.what();
+  }
+  World world = buildWorld(parseScene("physics: {integrator: implicit_euler}\nbodies:\n  - " + rod + "}\n", "ok.yaml"));
+  EXPECT_THROW(world.setIntegrator(IntegratorType::Rk4), std::invalid_argument);
+  EXPECT_EQ(world.integrator(), IntegratorType::ImplicitEuler);
 }
 
 TEST(SceneLoader, DirectoryCannotBeOpened)

@@ -9,6 +9,7 @@ MaterialScaling::MaterialScaling(const Model& built)
   : built_springs_(built.springs)
   , built_constraints_(built.constraints)
   , built_cells_(built.cells)
+  , built_rods_(built.rods)
   , scaling_(built.bodies.size())
   , has_material_(built.bodies.size(), 0)
 {
@@ -18,6 +19,8 @@ MaterialScaling::MaterialScaling(const Model& built)
     has_material_[built.bodyOf(constraint.a)] = 1;
   for (const PressureCell& cell : built.cells)
     has_material_[built.bodyOf(cell.nodes[0])] = 1;
+  for (const Rod& rod : built.rods)
+    has_material_[built.bodyOf(rod.first)] = 1;
 }
 
 void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& scaling)
@@ -41,6 +44,14 @@ void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& sca
   for (std::size_t k = 0; k < model.cells.size(); ++k)
     if (model.bodyOf(built_cells_[k].nodes[0]) == body)
       model.cells[k].pressure = built_cells_[k].pressure * scaling.pressure;
+  // A rod's bending and twisting scale with its stretching (its E and G), its damping beta with the dashpots.
+  for (std::size_t k = 0; k < model.rods.size(); ++k)
+    if (model.bodyOf(built_rods_[k].first) == body)
+    {
+      model.rods[k].bending_stiffness = built_rods_[k].bending_stiffness * scaling.stiffness;
+      model.rods[k].twisting_stiffness = built_rods_[k].twisting_stiffness * scaling.stiffness;
+      model.rods[k].damping = built_rods_[k].damping * scaling.damping;
+    }
 }
 
 }  // namespace soft_body_sim

@@ -164,6 +164,14 @@ std::string World::treatDiverged(std::size_t body)
   return freeze();
 }
 
+void World::setIntegrator(IntegratorType type)
+{
+  if (!model_.rods.empty() && type != IntegratorType::ImplicitEuler)
+    throw std::invalid_argument("a rod (type: rod) bends and twists only under implicit_euler, not " +
+                                integratorName(type));
+  integrators_.setAll(type);
+}
+
 bool World::takesTarget(std::size_t body) const
 {
   for (const BodyController& c : controllers_)

@@ -52,7 +52,16 @@ std::string SimNode::applySimConfig(const SimConfig& config)
     return risk->why;
   // Only what changed is set: a new integrator object (or a new dt) restarts multistep histories.
   if (integrator != world_->integrator())
-    world_->setIntegrator(integrator);
+  {
+    try
+    {
+      world_->setIntegrator(integrator);
+    }
+    catch (const std::invalid_argument& e)
+    {
+      return e.what();
+    }
+  }
   if (settings.dt != world_->settings().dt || settings.substeps != world_->settings().substeps ||
       settings.iterations != world_->settings().iterations)
   {

@@ -13,8 +13,8 @@ namespace soft_body_sim
 /// Live multipliers of one body's material, relative to the scene's values. 1 = as loaded; each > 0.
 struct BodyScaling
 {
-  double stiffness = 1.0;  ///< [-] spring stiffness k, and constraint stiffness 1 / compliance
-  double damping = 1.0;    ///< [-] spring dashpots c
+  double stiffness = 1.0;  ///< [-] spring stiffness k, constraint stiffness 1 / compliance, a rod's E I and G J
+  double damping = 1.0;    ///< [-] spring dashpots c, a rod's damping beta
   double pressure = 1.0;   ///< [-] rest gas pressure p0 of the body's cells
 };
 
@@ -36,6 +36,7 @@ private:
   std::vector<Spring> built_springs_;
   std::vector<DistanceConstraint> built_constraints_;
   std::vector<PressureCell> built_cells_;
+  std::vector<Rod> built_rods_;
   std::vector<BodyScaling> scaling_;  ///< per body
   std::vector<char> has_material_;    ///< per body
 };

@@ -103,7 +103,9 @@ public:
   /// std::invalid_argument on a bad value and keeps the old settings.
   void setStepSettings(const StepSettings& settings);
   /// Switches the integrator of every body; the new one starts from the current positions and velocities.
-  void setIntegrator(IntegratorType type) { integrators_.setAll(type); }
+  /// Throws std::invalid_argument (and keeps the old one) if the scene has a rod and `type` is not
+  /// implicit_euler, the only integrator that bends and twists rods.
+  void setIntegrator(IntegratorType type);
   /// [m/s^2], finite; throws std::invalid_argument otherwise.
   void setGravity(const Vec3& gravity);
   /// Linear air drag [1/s], finite and >= 0; throws std::invalid_argument otherwise.
