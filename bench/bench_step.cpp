@@ -7,6 +7,9 @@
 // (items = spring updates) and how the step cost grows with the node count (scripts/bench fits the
 // log-log slope); BM_ClothSpringForces is the force kernel alone on the 10,000-node cloth.
 // BM_StiffRopeImplicitEuler/<nodes>: implicit Euler's direct solve on a stiff rope, 100 to 100,000 nodes;
+// BM_Cable/<rod|spring_rope>/<nodes>: a cable by its material (rods.h) against the spring rope with bending
+// springs of the same mass, stretching stiffness and matrix pattern, implicit_euler at 1/60 s, clamped
+// (pinned) at one end; items = segments, so the two compare per segment per step.
 // BM_ClothLinearSolveAt60Hz/<cheaper|direct|iterative>/<nodes>: implicit Euler on the cloths at dt = 1/60 s,
 // 100 to 10,000 nodes, its linear solve made each way (cheaper: the rule's choice, what a scene gets).
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
@@ -24,6 +27,7 @@
 #include <benchmark/benchmark.h>
 
 #include "soft_body_sim/core/bodies/cloth.h"
+#include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/forces.h"
 #include "../src/core/integrators/integrator_kit.h"
@@ -161,6 +165,38 @@ void BM_StiffRopeImplicitEuler(benchmark::State& bench)
     benchmark::DoNotOptimize(world.state().position.data());
   }
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(rope.nodes));
+}
+
+/// The cable of BM_Cable: 1 m, radius 5 mm, E = 1 GPa, 1000 kg/m^3, its first node clamped, either as a rod
+/// or as a spring rope of the same mass and stretching springs (E A / l) with bending springs of the same
+/// stiffness to second neighbours (the same block pattern, which cannot express E I).
+void BM_Cable(benchmark::State& bench, bool rod)
+{
+  RodDef cable;
+  cable.nodes = static_cast<int>(bench.range(0));
+  cable.from = Vec3(0.0, 0.0, 1.0);
+  cable.to = Vec3(1.0, 0.0, 1.0);
+  cable.youngs_modulus = 1e9;
+  cable.clamped = { 0 };
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 1, 1 };
+  BodyDef body = buildRod("cable", cable);
+  if (!rod)
+  {
+    body.rod.reset();
+    for (int i = 0; i + 2 < cable.nodes; ++i)
+      body.springs.push_back(SpringDef{ i, i + 2, body.springs[0].stiffness, 0.0, std::nullopt });
+  }
+  scene.bodies.push_back(body);
+  World world = buildWorld(scene);
+  world.step();  // the pattern is analysed on the first step
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(cable.nodes - 1));
 }
 
 enum class Shape
@@ -428,6 +464,8 @@ BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, direct, LinearSolve::Direct)->Arg(1
 BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, iterative, LinearSolve::Iterative)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothSpringForces)->Arg(10000);
 BENCHMARK(BM_StiffRopeImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000);
+BENCHMARK_CAPTURE(BM_Cable, rod, true)->Arg(100)->Arg(1000)->Arg(10000);
+BENCHMARK_CAPTURE(BM_Cable, spring_rope, false)->Arg(100)->Arg(1000)->Arg(10000);
 BENCHMARK_CAPTURE(BM_RopeOnColliders, sphere, Shape::Sphere)->Args({ 1000, 0 })->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, capsule, Shape::Capsule)->Args({ 1000, 10 });
 BENCHMARK_CAPTURE(BM_RopeOnColliders, box, Shape::Box)->Args({ 1000, 10 });
