@@ -1,20 +1,9 @@
 #include "soft_body_sim/core/anchors.h"
 
+#include "soft_body_sim/core/rods.h"
+
 namespace soft_body_sim
 {
-namespace
-{
-/// The index in model.rods of the rod whose held end `end` (0 first, 1 last) is node `node`, or -1.
-int heldRodEnd(const Model& model, int node, int& end)
-{
-  for (std::size_t r = 0; r < model.rods.size(); ++r)
-    for (end = 0; end < 2; ++end)
-      if (model.rods[r].held[end] && node == (end == 0 ? model.rods[r].first : model.rods[r].last()))
-        return static_cast<int>(r);
-  return -1;
-}
-}  // namespace
-
 AnchorSet::AnchorSet(std::size_t scene_anchors)
   : goals_(scene_anchors)
   , paths_(scene_anchors)

@@ -1,11 +1,15 @@
 #include "soft_body_sim/core/rods.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace soft_body_sim
 {
 namespace
 {
+/// The least denominator l0 l1 + e0 . e1 of a curvature binormal, as a fraction of l0 l1 (see curvatureBinormal).
+constexpr double kMinFold = 1e-3;
+
 Eigen::Matrix3d cross(const Vec3& a)
 {
   Eigen::Matrix3d m;
@@ -56,9 +60,22 @@ Vec3 across(const Vec3& t, const Vec3& y)
 }
 }  // namespace
 
+int heldRodEnd(const Model& model, int node, int& end)
+{
+  for (std::size_t r = 0; r < model.rods.size(); ++r)
+    for (end = 0; end < 2; ++end)
+      if (model.rods[r].held[end] && node == (end == 0 ? model.rods[r].first : model.rods[r].last()))
+        return static_cast<int>(r);
+  return -1;
+}
+
 CurvatureBinormal curvatureBinormal(const Vec3& e0, const Vec3& e1, double rest_product)
 {
-  const double denominator = rest_product + e0.dot(e1);
+  // kb grows like tan(phi / 2) without bound as the bend folds back on itself (phi -> pi, D -> 0) and
+  // turns over past it: a step that folds a segment back (an anchor jerked past its neighbour) would
+  // divide by zero. D is kept at kMinFold of its straight value (a fold of 177 degrees), so the bend
+  // pushes back with a large, finite force.
+  const double denominator = std::max(rest_product + e0.dot(e1), kMinFold * rest_product);
   CurvatureBinormal bend;
   bend.kb = (2.0 / denominator) * e0.cross(e1);
   bend.d_e0 = -(2.0 * cross(e1) + bend.kb * e1.transpose()) / denominator;
@@ -108,7 +125,9 @@ void rodTwistGradient(const Rod& rod, const NodeArray& x, NodeArray& gradient)
     return;
   // Both ends are held: tangent 0 is the first held axis, j + 1 segment j's, the last the last held axis.
   const Tangents t{ rod, x };
-  const auto unit_kb = [](const Vec3& a, const Vec3& b) -> Vec3 { return 2.0 * a.cross(b) / (1.0 + a.dot(b)); };
+  const auto unit_kb = [](const Vec3& a, const Vec3& b) -> Vec3 {
+    return 2.0 * a.cross(b) / std::max(1.0 + a.dot(b), kMinFold);
+  };
   Vec3 before = t[0];
   Vec3 tangent = t[1];
   for (int j = 0; j + 1 < rod.count; ++j)
@@ -135,8 +154,7 @@ double rodEnergy(const Rod& rod, const NodeArray& x, double twist)
   {
     Vec3 e0, e1;
     vertexEdges(rod, vertex, x, e0, e1);
-    const double rest_product = rod.segment_length * rod.segment_length;
-    energy += vertex.weight * (2.0 * e0.cross(e1) / (rest_product + e0.dot(e1))).squaredNorm();
+    energy += vertex.weight * curvatureBinormal(e0, e1, rod.segment_length * rod.segment_length).kb.squaredNorm();
   }
   if (rod.twists())
     energy += 0.5 * rod.twisting_stiffness * twist * twist / rod.restLength();

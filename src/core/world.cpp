@@ -318,10 +318,10 @@ std::vector<Wrench> World::anchorWrenches() const
   {
     wrenches.push_back(holdingWrench(model_, state_.position, pull, { anchor.node }, state_.position.col(anchor.node)));
     // A rod's held end takes its bending and twisting moment too.
-    for (std::size_t r = 0; r < model_.rods.size(); ++r)
-      for (int end = 0; end < 2; ++end)
-        if (model_.rods[r].held[end] && anchor.node == (end == 0 ? model_.rods[r].first : model_.rods[r].last()))
-          wrenches.back().torque += heldEndTorque(model_.rods[r], state_.position, rodTwistOf(r), end);
+    int end = 0;
+    if (const int r = heldRodEnd(model_, anchor.node, end); r >= 0)
+      wrenches.back().torque += heldEndTorque(model_.rods[static_cast<std::size_t>(r)], state_.position,
+                                              rodTwistOf(static_cast<std::size_t>(r)), end);
   }
   return wrenches;
 }

@@ -10,6 +10,7 @@
 
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
+#include "soft_body_sim/core/rods.h"
 #include "soft_body_sim/ros/sim_node.h"
 
 namespace soft_body_sim
@@ -173,6 +174,7 @@ void SimNode::applyDueInputs(const ros::Time& step_end)
   {
     if (input.kind == ScheduledInput::Kind::Anchor)
     {
+      warnIfRodEndJumps(input);
       if (input.orientation)
         world_->moveAnchor(input.anchor, input.position, *input.orientation);
       else
@@ -190,6 +192,28 @@ void SimNode::applyDueInputs(const ros::Time& step_end)
     if (!known)
       targets_.emplace_back(input.body, input.position);
   }
+}
+
+void SimNode::warnIfRodEndJumps(const ScheduledInput& input) const
+{
+  // A rod's bend stiffens without bound only up to a fold (rods.h): an end moved past its neighbour within
+  // one linearised sub-step can fold its last segment back, which unfolds only slowly.
+  const Model& model = world_->model();
+  const Anchor& anchor = model.anchors[static_cast<std::size_t>(input.anchor)];
+  int end = 0;
+  const int r = heldRodEnd(model, anchor.node, end);
+  if (r < 0)
+    return;
+  const int substeps = world_->settings().substeps;
+  const double segment = model.rods[static_cast<std::size_t>(r)].segment_length;
+  const double jump = (input.position - world_->state().position.col(anchor.node)).norm();
+  if (jump <= segment * substeps)
+    return;
+  ROS_WARN_THROTTLE(5.0,
+                    "%s: anchor '%s' of rod '%s' moves %.3g m in one step, more than a segment (%.3g m) per sub-step: "
+                    "its end may fold back on itself; move it in smaller steps or set physics.substeps >= %d",
+                    name_.c_str(), anchor.name.c_str(), anchor.body.c_str(), jump, segment,
+                    static_cast<int>(std::ceil(jump / segment)));
 }
 
 bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position,

@@ -52,6 +52,10 @@ void appendRodVertices(const Rod& rod, std::vector<RodVertex>& vertices);
 /// The two edges [m] of vertex `vertex` of `rod` at positions x (see RodVertex).
 void vertexEdges(const Rod& rod, const RodVertex& vertex, const NodeArray& x, Vec3& e0, Vec3& e1);
 
+/// The index in model.rods of the rod whose held end is node `node`, with that end (0 first, 1 last) in
+/// `end`; -1 if no rod holds an end there.
+int heldRodEnd(const Model& model, int node, int& end);
+
 /// The unit axis of a held end's frame now (end 0: first node, 1: last), pointing along the rod.
 inline Vec3 heldAxis(const Rod& rod, int end) { return rod.end_frame[end] * Vec3::UnitX(); }
 

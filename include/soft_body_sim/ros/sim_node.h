@@ -71,6 +71,8 @@ private:
   /// warning naming `topic` (stale, too far ahead); warns when its source was full.
   void schedule(const std::string& topic, const ros::Time& stamp, const ScheduledInput& input);
   void applyDueInputs(const ros::Time& step_end);
+  /// Warns (throttled) when an anchor input would move a rod's held end more than a segment per sub-step.
+  void warnIfRodEndJumps(const ScheduledInput& input) const;
   /// The pose's position in the scene frame, and if `orientation` is given its orientation there (nullopt
   /// when the message's is all zeros, RosConverter::fromPose); false (with a throttled warning naming
   /// `topic` and the reason) if it is not finite or its frame cannot be transformed.
