@@ -177,6 +177,9 @@ void ChainSolver::reserve(std::size_t rows)
   step_b_.resize(3, n);
   upper_.resize(rows);
   delta_.resize(rows);
+  path_.resize(rows + 1);
+  a_leads_.resize(rows);
+  node_mobility_.resize(rows + 1);
 }
 
 ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
@@ -268,18 +271,49 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
   }
   // The mobility W~ = M~^-1 at each row's two nodes (zero at a pinned one). A free node of a chain meets
   // at most two rows, consecutive ones: the node row i shares with row i - 1 has that row's mobility.
-  int shared_before = -1;
+  // Without contacts, in closed form per node of the path (see NodeMobility); with them, as 3 x 3
+  // matrices, which a sliding node's projection and friction make general (mobility()).
   for (std::size_t i = 0; i < count; ++i)
   {
-    const SweepRow& row = rows[i];
-    const auto before = [&]() -> const Matrix3& {
-      return rows[i - 1].a == shared_before ? mobility_a_[i - 1] : mobility_b_[i - 1];
-    };
-    mobility_a_[i] = row.a == shared_before ? before() : mobility(rows, count, i, row.a, inverse_mass, holds);
-    mobility_b_[i] = row.b == shared_before ? before() : mobility(rows, count, i, row.b, inverse_mass, holds);
-    if (i + 1 < count)
-      shared_before = row.a == rows[i + 1].a || row.a == rows[i + 1].b ? row.a : row.b;
+    const bool last = i + 1 == count;
+    const int shared = last ? -1 : (rows[i].a == rows[i + 1].a || rows[i].a == rows[i + 1].b ? rows[i].a : rows[i].b);
+    a_leads_[i] = last ? (i == 0 || rows[i].a == path_[i]) : (rows[i].a != shared);
+    path_[i + 1] = last ? (a_leads_[i] ? rows[i].b : rows[i].a) : shared;
+    if (i == 0)
+      path_[0] = a_leads_[0] ? rows[0].a : rows[0].b;
   }
+  const bool general = holds != nullptr;
+  if (general)
+  {
+    int shared_before = -1;
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      const SweepRow& row = rows[i];
+      const auto before = [&]() -> const Matrix3& {
+        return rows[i - 1].a == shared_before ? mobility_a_[i - 1] : mobility_b_[i - 1];
+      };
+      mobility_a_[i] = row.a == shared_before ? before() : mobility(rows, count, i, row.a, inverse_mass, holds);
+      mobility_b_[i] = row.b == shared_before ? before() : mobility(rows, count, i, row.b, inverse_mass, holds);
+      shared_before = path_[i + 1];
+    }
+  }
+  else
+  {
+    for (std::size_t p = 0; p <= count; ++p)
+      node_mobility_[p] = nodeMobility(inverse_mass[path_[p]], p > 0 ? geometric_[p - 1] : 0.0,
+                                       p < count ? geometric_[p] : 0.0,
+                                       p > 0 && p < count ? direction_.col(static_cast<Eigen::Index>(p - 1))
+                                                                .dot(direction_.col(static_cast<Eigen::Index>(p)))
+                                                          : 0.0);
+  }
+  // W~ v at row i's node a (at_a) or b.
+  const auto move = [&](std::size_t i, bool at_a, const Vec3& v) -> Vec3 {
+    if (general)
+      return (at_a ? mobility_a_[i] : mobility_b_[i]) * v;
+    const std::size_t p = at_a == static_cast<bool>(a_leads_[i]) ? i : i + 1;
+    return node_mobility_[p].times(p > 0 ? Vec3(direction_.col(static_cast<Eigen::Index>(p - 1))) : Vec3::Zero(),
+                                   p < count ? Vec3(direction_.col(static_cast<Eigen::Index>(p))) : Vec3::Zero(), v);
+  };
   // The known forces of the first Newton step, as impulses h^2 f [kg m] on each row's two nodes
   // (ChainSolver::solve): kinetic friction that the rows do not cause (NodeHolds::push) and the part of the
   // lumped geometric stiffness that the exact one does not have, at the last sub-step's correction c:
@@ -316,8 +350,8 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
             lag += lag_.col(static_cast<Eigen::Index>(k));
         (node == rows[i].a ? push_a_ : push_b_).col(column) += lag;
       }
-      push_a_.col(column) = mobility_a_[i] * push_a_.col(column);
-      push_b_.col(column) = mobility_b_[i] * push_b_.col(column);
+      push_a_.col(column) = move(i, true, push_a_.col(column));
+      push_b_.col(column) = move(i, false, push_b_.col(column));
       rhs_[i] -= direction_.col(column).dot(push_a_.col(column) - push_b_.col(column));
     }
   }
@@ -331,8 +365,23 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     const SweepRow& row = rows[i];
     const Vec3 u = direction_.col(static_cast<Eigen::Index>(i));
     const double scale = 1.0 / (1.0 + row.gamma);
-    diagonal_[i] = u.isZero(0.0) ? 1.0 : u.dot((mobility_a_[i] + mobility_b_[i]) * u) + row.alpha_tilde * scale;
     rhs_[i] *= scale;
+    const bool moves = !u.isZero(0.0);
+    if (!general)
+    {
+      // Row i is the right-hand row of path node i and the left-hand row of path node i + 1.
+      const NodeMobility& left = node_mobility_[i];
+      const NodeMobility& right = node_mobility_[i + 1];
+      diagonal_[i] = moves ? left.rightRight() + right.leftLeft() + row.alpha_tilde * scale : 1.0;
+      if (i + 1 == count)
+        continue;
+      // The signs of gradC at the shared node: +u at a row's node a, -u at its node b.
+      const double sign = (a_leads_[i] ? -1.0 : 1.0) * (a_leads_[i + 1] ? 1.0 : -1.0);
+      coupling_[i] = sign * right.leftRight();
+      coupling_below_[i] = coupling_[i];
+      continue;
+    }
+    diagonal_[i] = moves ? u.dot((mobility_a_[i] + mobility_b_[i]) * u) + row.alpha_tilde * scale : 1.0;
     if (i + 1 == count)
       continue;
     const SweepRow& next = rows[i + 1];
@@ -373,8 +422,8 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
   {
     const Eigen::Index column = static_cast<Eigen::Index>(i);
     const Vec3 u = direction_.col(column);
-    step_a_.col(column) = mobility_a_[i] * (delta_[i] * u);
-    step_b_.col(column) = mobility_b_[i] * (delta_[i] * u);
+    step_a_.col(column) = move(i, true, delta_[i] * u);
+    step_b_.col(column) = move(i, false, delta_[i] * u);
     const double reach = kReach * rows[i].rest_length;
     if (bounded &&
         (step_a_.col(column).squaredNorm() > reach * reach || step_b_.col(column).squaredNorm() > reach * reach))
@@ -399,6 +448,21 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
         x.col(row.b) += push_b_.col(static_cast<Eigen::Index>(i));
     }
   return true;
+}
+
+ChainSolver::NodeMobility ChainSolver::nodeMobility(double w, double left, double right, double s)
+{
+  if (w == 0.0)
+    return NodeMobility{ 0.0, 0.0, 0.0, 0.0, s };
+  // Without tension M~ = m I: w I exactly, as the Gauss-Seidel update uses.
+  if (left == 0.0 && right == 0.0)
+    return NodeMobility{ w, 0.0, 0.0, 0.0, s };
+  // In units of the node's mass: a = w g_l, b = w g_r, c = 1 + a + b, D = (1 + a)(1 + b) - a b s^2 > 0.
+  const double a = w * left;
+  const double b = w * right;
+  const double d = (1.0 + a) * (1.0 + b) - a * b * s * s;
+  const double f = w / ((1.0 + a + b) * d);
+  return NodeMobility{ d * f, a * (1.0 + a) * f, a * b * s * f, b * (1.0 + b) * f, s };
 }
 
 ChainSolver::Matrix3 ChainSolver::mobility(const SweepRow* rows, std::size_t count, std::size_t i, int node,
