@@ -178,6 +178,8 @@ void ChainSolver::reserve(std::size_t rows)
   upper_.resize(rows);
   delta_.resize(rows);
   path_.resize(rows + 1);
+  node_push_.resize(3, n + 1);
+  node_step_.resize(3, n + 1);
   a_leads_.resize(rows);
   node_mobility_.resize(rows + 1);
 }
@@ -242,78 +244,78 @@ void ChainSolver::restart(const SweepRow* rows, std::size_t count, NodeArray& x,
   }
 }
 
+// Inlined into both steps' loops: called, they cost the chain solve 10 % (measured).
+[[gnu::always_inline]] inline void ChainSolver::evaluateRow(const SweepRow& row, std::size_t i,
+                                                            const NodeArray& x_prev, double h, const NodeArray& x,
+                                                            double lambda)
+{
+  // The row at the current positions (as projectDistance, but every row at the same x): its direction,
+  // its right-hand side -C - alpha~ lambda - gamma u . ((x_a - x_prev_a) - (x_b - x_prev_b)), and its
+  // lumped geometric stiffness 2 h^2 T / l [kg] (see the class comment).
+  const Eigen::Index column = static_cast<Eigen::Index>(i);
+  direction_.col(column).setZero();
+  rhs_[i] = 0.0;
+  geometric_[i] = 0.0;
+  if (row.inverse_denominator == 0.0)
+    return;  // both ends pinned: dlambda = 0
+  const Vec3 d = x.col(row.a) - x.col(row.b);
+  const double length = d.norm();
+  if (length < kMinSpringLength)
+    return;  // coincident nodes: the direction is undefined
+  const double inverse_length = 1.0 / length;
+  const Vec3 u = d * inverse_length;
+  direction_.col(column) = u;
+  const double c_rate_h =
+      row.gamma == 0.0 ? 0.0 : u.dot((x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b)));
+  rhs_[i] = -(length - row.rest_length) - row.alpha_tilde * lambda - row.gamma * c_rate_h;
+  geometric_[i] = 2.0 * h * h * estimate_[i] * inverse_length;
+}
+
+[[gnu::always_inline]] inline void ChainSolver::eliminate(std::size_t i, std::size_t count)
+{
+  // Thomas algorithm (LDL^T of a tridiagonal matrix, LU where it is unsymmetric): for a symmetric positive
+  // definite matrix it is stable without pivoting and every pivot is positive; friction's unsymmetric part
+  // is at most mu times a sliding node's normal coupling. With a free end the rows are independent, so a
+  // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); pinned at both ends, the
+  // last one vanishes where the chain is straight (partitionRows). One within the round-off of the
+  // subtraction that made it is treated as zero: its row keeps dlambda = 0 and the others are solved
+  // without it, rather than divided by noise.
+  constexpr double kPivotFloor = 64.0 * std::numeric_limits<double>::epsilon();
+  const double lower = i > 0 ? coupling_below_[i - 1] : 0.0;
+  const double pivot = i > 0 ? diagonal_[i] - lower * upper_[i - 1] : diagonal_[i];
+  if (!(pivot > kPivotFloor * diagonal_[i]))
+  {
+    upper_[i] = 0.0;
+    delta_[i] = 0.0;
+    return;
+  }
+  const double inverse_pivot = 1.0 / pivot;
+  upper_[i] = i + 1 < count ? coupling_[i] * inverse_pivot : 0.0;
+  delta_[i] = (rhs_[i] - (i > 0 ? lower * delta_[i - 1] : 0.0)) * inverse_pivot;
+}
+
 bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
                              const NodeArray& x_prev, double h, const NodeHolds* holds,
                              const NodeArray* correction, bool push, bool bounded, NodeArray& x, double* lambda)
 {
-  // Each row at the current positions (as projectDistance, but every row at the same x): its direction,
-  // its right-hand side -C - alpha~ lambda - gamma u . ((x_a - x_prev_a) - (x_b - x_prev_b)), and its
-  // lumped geometric stiffness 2 h^2 T / l [kg] (see the class comment).
+  if (holds == nullptr)
+    return freeStep(rows, count, inverse_mass, x_prev, h, push ? correction : nullptr, bounded, x, lambda);
+  for (std::size_t i = 0; i < count; ++i)
+    evaluateRow(rows[i], i, x_prev, h, x, lambda[i]);
+  // The mobility W~ = M~^-1 at each row's two nodes (zero at a pinned one). A free node of a chain meets
+  // at most two rows, consecutive ones: the node row i shares with row i - 1 has that row's mobility.
+  int shared_before = -1;
   for (std::size_t i = 0; i < count; ++i)
   {
     const SweepRow& row = rows[i];
-    const Eigen::Index column = static_cast<Eigen::Index>(i);
-    direction_.col(column).setZero();
-    rhs_[i] = 0.0;
-    geometric_[i] = 0.0;
-    if (row.inverse_denominator == 0.0)
-      continue;  // both ends pinned: dlambda = 0
-    const Vec3 d = x.col(row.a) - x.col(row.b);
-    const double length = d.norm();
-    if (length < kMinSpringLength)
-      continue;  // coincident nodes: the direction is undefined
-    const Vec3 u = d * (1.0 / length);
-    direction_.col(column) = u;
-    const double c_rate_h =
-        row.gamma == 0.0 ? 0.0 : u.dot((x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b)));
-    rhs_[i] = -(length - row.rest_length) - row.alpha_tilde * lambda[i] - row.gamma * c_rate_h;
-    geometric_[i] = 2.0 * h * h * estimate_[i] / length;
+    const auto before = [&]() -> const Matrix3& {
+      return rows[i - 1].a == shared_before ? mobility_a_[i - 1] : mobility_b_[i - 1];
+    };
+    mobility_a_[i] = row.a == shared_before ? before() : mobility(rows, count, i, row.a, inverse_mass, holds);
+    mobility_b_[i] = row.b == shared_before ? before() : mobility(rows, count, i, row.b, inverse_mass, holds);
+    if (i + 1 < count)
+      shared_before = row.a == rows[i + 1].a || row.a == rows[i + 1].b ? row.a : row.b;
   }
-  // The mobility W~ = M~^-1 at each row's two nodes (zero at a pinned one). A free node of a chain meets
-  // at most two rows, consecutive ones: the node row i shares with row i - 1 has that row's mobility.
-  // Without contacts, in closed form per node of the path (see NodeMobility); with them, as 3 x 3
-  // matrices, which a sliding node's projection and friction make general (mobility()).
-  for (std::size_t i = 0; i < count; ++i)
-  {
-    const bool last = i + 1 == count;
-    const int shared = last ? -1 : (rows[i].a == rows[i + 1].a || rows[i].a == rows[i + 1].b ? rows[i].a : rows[i].b);
-    a_leads_[i] = last ? (i == 0 || rows[i].a == path_[i]) : (rows[i].a != shared);
-    path_[i + 1] = last ? (a_leads_[i] ? rows[i].b : rows[i].a) : shared;
-    if (i == 0)
-      path_[0] = a_leads_[0] ? rows[0].a : rows[0].b;
-  }
-  const bool general = holds != nullptr;
-  if (general)
-  {
-    int shared_before = -1;
-    for (std::size_t i = 0; i < count; ++i)
-    {
-      const SweepRow& row = rows[i];
-      const auto before = [&]() -> const Matrix3& {
-        return rows[i - 1].a == shared_before ? mobility_a_[i - 1] : mobility_b_[i - 1];
-      };
-      mobility_a_[i] = row.a == shared_before ? before() : mobility(rows, count, i, row.a, inverse_mass, holds);
-      mobility_b_[i] = row.b == shared_before ? before() : mobility(rows, count, i, row.b, inverse_mass, holds);
-      shared_before = path_[i + 1];
-    }
-  }
-  else
-  {
-    for (std::size_t p = 0; p <= count; ++p)
-      node_mobility_[p] = nodeMobility(inverse_mass[path_[p]], p > 0 ? geometric_[p - 1] : 0.0,
-                                       p < count ? geometric_[p] : 0.0,
-                                       p > 0 && p < count ? direction_.col(static_cast<Eigen::Index>(p - 1))
-                                                                .dot(direction_.col(static_cast<Eigen::Index>(p)))
-                                                          : 0.0);
-  }
-  // W~ v at row i's node a (at_a) or b.
-  const auto move = [&](std::size_t i, bool at_a, const Vec3& v) -> Vec3 {
-    if (general)
-      return (at_a ? mobility_a_[i] : mobility_b_[i]) * v;
-    const std::size_t p = at_a == static_cast<bool>(a_leads_[i]) ? i : i + 1;
-    return node_mobility_[p].times(p > 0 ? Vec3(direction_.col(static_cast<Eigen::Index>(p - 1))) : Vec3::Zero(),
-                                   p < count ? Vec3(direction_.col(static_cast<Eigen::Index>(p))) : Vec3::Zero(), v);
-  };
   // The known forces of the first Newton step, as impulses h^2 f [kg m] on each row's two nodes
   // (ChainSolver::solve): kinetic friction that the rows do not cause (NodeHolds::push) and the part of the
   // lumped geometric stiffness that the exact one does not have, at the last sub-step's correction c:
@@ -350,8 +352,8 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
             lag += lag_.col(static_cast<Eigen::Index>(k));
         (node == rows[i].a ? push_a_ : push_b_).col(column) += lag;
       }
-      push_a_.col(column) = move(i, true, push_a_.col(column));
-      push_b_.col(column) = move(i, false, push_b_.col(column));
+      push_a_.col(column) = mobility_a_[i] * push_a_.col(column);
+      push_b_.col(column) = mobility_b_[i] * push_b_.col(column);
       rhs_[i] -= direction_.col(column).dot(push_a_.col(column) - push_b_.col(column));
     }
   }
@@ -365,23 +367,8 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     const SweepRow& row = rows[i];
     const Vec3 u = direction_.col(static_cast<Eigen::Index>(i));
     const double scale = 1.0 / (1.0 + row.gamma);
+    diagonal_[i] = u.isZero(0.0) ? 1.0 : u.dot((mobility_a_[i] + mobility_b_[i]) * u) + row.alpha_tilde * scale;
     rhs_[i] *= scale;
-    const bool moves = !u.isZero(0.0);
-    if (!general)
-    {
-      // Row i is the right-hand row of path node i and the left-hand row of path node i + 1.
-      const NodeMobility& left = node_mobility_[i];
-      const NodeMobility& right = node_mobility_[i + 1];
-      diagonal_[i] = moves ? left.rightRight() + right.leftLeft() + row.alpha_tilde * scale : 1.0;
-      if (i + 1 == count)
-        continue;
-      // The signs of gradC at the shared node: +u at a row's node a, -u at its node b.
-      const double sign = (a_leads_[i] ? -1.0 : 1.0) * (a_leads_[i + 1] ? 1.0 : -1.0);
-      coupling_[i] = sign * right.leftRight();
-      coupling_below_[i] = coupling_[i];
-      continue;
-    }
-    diagonal_[i] = moves ? u.dot((mobility_a_[i] + mobility_b_[i]) * u) + row.alpha_tilde * scale : 1.0;
     if (i + 1 == count)
       continue;
     const SweepRow& next = rows[i + 1];
@@ -392,28 +379,9 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     coupling_[i] = sign * u.dot(shared * v);
     coupling_below_[i] = sign * v.dot(shared * u);
   }
-  // Thomas algorithm (LDL^T of a tridiagonal matrix, LU where it is unsymmetric): for a symmetric positive
-  // definite matrix it is stable without pivoting and every pivot is positive; friction's unsymmetric part
-  // is at most mu times a sliding node's normal coupling. With a free end the rows are independent, so a
-  // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); pinned at both ends, the
-  // last one vanishes where the chain is straight (partitionRows). One within the round-off of the
-  // subtraction that made it is treated as zero: its row keeps dlambda = 0 and the others are solved
-  // without it, rather than divided by noise.
-  constexpr double kPivotFloor = 64.0 * std::numeric_limits<double>::epsilon();
+  // Thomas algorithm (eliminate()).
   for (std::size_t i = 0; i < count; ++i)
-  {
-    const double lower = i > 0 ? coupling_below_[i - 1] : 0.0;
-    const double pivot = i > 0 ? diagonal_[i] - lower * upper_[i - 1] : diagonal_[i];
-    if (!(pivot > kPivotFloor * diagonal_[i]))
-    {
-      upper_[i] = 0.0;
-      delta_[i] = 0.0;
-      continue;
-    }
-    const double inverse_pivot = 1.0 / pivot;
-    upper_[i] = i + 1 < count ? coupling_[i] * inverse_pivot : 0.0;
-    delta_[i] = (rhs_[i] - (i > 0 ? lower * delta_[i - 1] : 0.0)) * inverse_pivot;
-  }
+    eliminate(i, count);
   for (std::size_t i = count - 1; i-- > 0;)
     delta_[i] -= upper_[i] * delta_[i + 1];
   // x += W~ J^T dlambda, row by row; on a chain pinned at both ends (`bounded`) only if no node moves by
@@ -422,8 +390,8 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
   {
     const Eigen::Index column = static_cast<Eigen::Index>(i);
     const Vec3 u = direction_.col(column);
-    step_a_.col(column) = move(i, true, delta_[i] * u);
-    step_b_.col(column) = move(i, false, delta_[i] * u);
+    step_a_.col(column) = mobility_a_[i] * (delta_[i] * u);
+    step_b_.col(column) = mobility_b_[i] * (delta_[i] * u);
     const double reach = kReach * rows[i].rest_length;
     if (bounded &&
         (step_a_.col(column).squaredNorm() > reach * reach || step_b_.col(column).squaredNorm() > reach * reach))
@@ -447,6 +415,92 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
       if (first_time(row.b))
         x.col(row.b) += push_b_.col(static_cast<Eigen::Index>(i));
     }
+  return true;
+}
+
+bool ChainSolver::freeStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
+                           const NodeArray& x_prev, double h, const NodeArray* correction, bool bounded, NodeArray& x,
+                           double* lambda)
+{
+  // newtonStep without contacts, node by node along the path (path_[p] joins rows p - 1 and p), in short
+  // passes: the rows, each on its own; the nodes' mobility (NodeMobility) and known displacement, each from
+  // its two rows; the system and its elimination, the one pass where each row waits for the last.
+  const auto column = [](std::size_t i) { return static_cast<Eigen::Index>(i); };
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    // Row i joins path_[i] and path_[i + 1]: the node it shares with row i + 1 is its second.
+    const SweepRow& row = rows[i];
+    a_leads_[i] = i + 1 < count ? row.a != rows[i + 1].a && row.a != rows[i + 1].b : i == 0 || row.a == path_[i];
+    if (i == 0)
+      path_[0] = a_leads_[0] ? row.a : row.b;
+    path_[i + 1] = a_leads_[i] ? row.b : row.a;
+    evaluateRow(row, i, x_prev, h, x, lambda[i]);
+    // The lag of the lumped stiffness, h^2 T / l P (c_a + c_b) on each node (newtonStep).
+    lag_.col(column(i)).setZero();
+    if (correction != nullptr && geometric_[i] != 0.0)
+    {
+      const Vec3 u = direction_.col(column(i));
+      const Vec3 sum = correction->col(row.a) + correction->col(row.b);
+      lag_.col(column(i)) = 0.5 * geometric_[i] * (sum - u * u.dot(sum));
+    }
+  }
+  for (std::size_t p = 0; p <= count; ++p)
+  {
+    const Vec3 u_left = p > 0 ? Vec3(direction_.col(column(p - 1))) : Vec3::Zero();
+    const Vec3 u_right = p < count ? Vec3(direction_.col(column(p))) : Vec3::Zero();
+    const NodeMobility node = nodeMobility(inverse_mass[path_[p]], p > 0 ? geometric_[p - 1] : 0.0,
+                                           p < count ? geometric_[p] : 0.0, u_left.dot(u_right));
+    node_mobility_[p] = node;
+    if (correction == nullptr)
+      continue;
+    const Vec3 lag = p == 0 ? Vec3(lag_.col(0)) : p == count ? Vec3(lag_.col(column(p - 1)))
+                                                          : Vec3(lag_.col(column(p - 1)) + lag_.col(column(p)));
+    node_push_.col(column(p)) = node.times(u_left, u_right, lag);
+  }
+  // Row r is the right-hand row of path node r and the left-hand row of node r + 1 (see newtonStep for the
+  // system), eliminated as it is made.
+  for (std::size_t r = 0; r < count; ++r)
+  {
+    const SweepRow& row = rows[r];
+    const Vec3 u = direction_.col(column(r));
+    const NodeMobility& node = node_mobility_[r + 1];
+    if (correction != nullptr)
+      rhs_[r] -= (a_leads_[r] ? 1.0 : -1.0) * u.dot(node_push_.col(column(r)) - node_push_.col(column(r + 1)));
+    const double scale = row.gamma == 0.0 ? 1.0 : 1.0 / (1.0 + row.gamma);
+    rhs_[r] *= scale;
+    diagonal_[r] = u.isZero(0.0) ? 1.0 : node_mobility_[r].rightRight() + node.leftLeft() + row.alpha_tilde * scale;
+    // The signs of gradC at the shared node: +u at a row's node a, -u at its node b.
+    coupling_[r] =
+        r + 1 < count ? (a_leads_[r] ? -1.0 : 1.0) * (a_leads_[r + 1] ? 1.0 : -1.0) * node.leftRight() : 0.0;
+    coupling_below_[r] = coupling_[r];
+    eliminate(r, count);
+  }
+  for (std::size_t i = count - 1; i-- > 0;)
+    delta_[i] -= upper_[i] * delta_[i + 1];
+  // x += W~ J^T dlambda, node by node: gradC is +u at a row's node a, -u at its node b. On a chain pinned at
+  // both ends (`bounded`) only if no row moves a node by more than kReach rest lengths: else nothing is changed.
+  for (std::size_t p = 0; p <= count; ++p)
+  {
+    const NodeMobility& node = node_mobility_[p];
+    const Vec3 u_l = p > 0 ? Vec3(direction_.col(column(p - 1))) : Vec3::Zero();
+    const Vec3 u_r = p < count ? Vec3(direction_.col(column(p))) : Vec3::Zero();
+    const Vec3 by_left =
+        p > 0 ? node.leftTimes(u_l, u_r, (a_leads_[p - 1] ? -1.0 : 1.0) * delta_[p - 1]) : Vec3::Zero();
+    const Vec3 by_right = p < count ? node.rightTimes(u_l, u_r, (a_leads_[p] ? 1.0 : -1.0) * delta_[p]) : Vec3::Zero();
+    if (bounded)
+    {
+      const double reach_left = p > 0 ? kReach * rows[p - 1].rest_length : 0.0;
+      const double reach_right = p < count ? kReach * rows[p].rest_length : 0.0;
+      if (by_left.squaredNorm() > reach_left * reach_left || by_right.squaredNorm() > reach_right * reach_right)
+        return false;
+    }
+    node_step_.col(column(p)) = by_left + by_right;
+  }
+  for (std::size_t i = 0; i < count; ++i)
+    lambda[i] += delta_[i];
+  for (std::size_t p = 0; p <= count; ++p)
+    x.col(path_[p]) += correction != nullptr ? Vec3(node_step_.col(column(p)) + node_push_.col(column(p)))
+                                             : Vec3(node_step_.col(column(p)));
   return true;
 }
 

@@ -152,6 +152,17 @@ private:
                   double h, const NodeHolds* holds, const NodeArray* correction, bool push, bool bounded,
                   NodeArray& x, double* lambda);
 
+  /// The row's direction, right-hand side and lumped geometric stiffness at the current positions.
+  void evaluateRow(const SweepRow& row, std::size_t i, const NodeArray& x_prev, double h, const NodeArray& x,
+                   double lambda);
+
+  /// Row i's step of the Thomas algorithm's forward elimination.
+  void eliminate(std::size_t i, std::size_t count);
+
+  /// newtonStep without contacts, in one pass along the chain (`correction` null: no known forces).
+  bool freeStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+                double h, const NodeArray* correction, bool bounded, NodeArray& x, double* lambda);
+
   /// W~ = M~^-1 at a node of the path without contacts, where M~ = m I + g_l (I - u_l u_l^T) + g_r (I - u_r u_r^T)
   /// (g_l, g_r the lumped geometric stiffness of the rows to its left and right along the path, u_l, u_r their
   /// directions; g = 0 and u = 0 where there is no such row). M~ is c I - U G U^T with c = m + g_l + g_r,
@@ -172,6 +183,15 @@ private:
       const double pl = left.dot(v);
       const double pr = right.dot(v);
       return inverse * v + (ll * pl + lr * pr) * left + (lr * pl + rr * pr) * right;
+    }
+    /// W~ (alpha u_l) and W~ (beta u_r).
+    Vec3 leftTimes(const Vec3& left, const Vec3& right, double alpha) const
+    {
+      return alpha * ((inverse + ll + lr * s) * left + (lr + rr * s) * right);
+    }
+    Vec3 rightTimes(const Vec3& left, const Vec3& right, double beta) const
+    {
+      return beta * ((ll * s + lr) * left + (inverse + lr * s + rr) * right);
     }
     double leftLeft() const { return inverse + ll + s * (2.0 * lr + rr * s); }     ///< u_l . W~ u_l
     double rightRight() const { return inverse + rr + s * (2.0 * lr + ll * s); }   ///< u_r . W~ u_r
@@ -211,6 +231,8 @@ private:
   std::vector<int> path_;         ///< the chain's nodes in path order: row i joins path_[i] and path_[i + 1]
   std::vector<std::uint8_t> a_leads_;  ///< per row: 1 if its node a is path_[i]
   std::vector<NodeMobility> node_mobility_;  ///< W~ per node of the path, without contacts
+  NodeArray node_step_;           ///< per node of the path, W~ J^T dlambda, without contacts [m]
+  NodeArray node_push_;           ///< per node of the path, its known displacement in the first step [m]
 };
 
 }  // namespace soft_body_sim
