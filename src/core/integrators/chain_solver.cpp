@@ -188,6 +188,19 @@ ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count,
                         const NodeArray& x_prev, double h, const double* tension, bool heavy,
                         const NodeHolds* holds, const NodeArray* correction, bool push, NodeArray& x, double* lambda)
 {
+  // An even chain whose tension impulse rivals its nodes' masses is refused (see the class comment): the
+  // load h^2 T w / l exceeds kEvenLoad at a node of a row, compared without a division.
+  const bool even = !heavy;
+  bool loaded = false;
+  for (std::size_t i = 0; even && i < count; ++i)
+    loaded |= h * h * tension[i] * std::max(inverse_mass[rows[i].a], inverse_mass[rows[i].b]) >
+              kEvenLoad * std::max(rows[i].rest_length, kMinSpringLength);
+  if (loaded)
+    return kLoaded;
+  const auto outer = [&](std::size_t i, std::size_t next) {
+    return rows[i].a == rows[next].a || rows[i].a == rows[next].b ? rows[i].b : rows[i].a;
+  };
+  const bool bounded = count > 1 && inverse_mass[outer(0, 1)] == 0.0 && inverse_mass[outer(count - 1, count - 2)] == 0.0;
   for (std::size_t i = 0; i < count; ++i)
   {
     start_a_.col(static_cast<Eigen::Index>(i)) = x.col(rows[i].a);
@@ -195,19 +208,6 @@ ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count,
     start_lambda_[i] = lambda[i];
     estimate_[i] = tension[i];
   }
-  // An even chain whose tension impulse rivals its nodes' masses is refused (see the class comment).
-  const bool even = !heavy;
-  double load = 0.0;
-  for (std::size_t i = 0; even && i < count; ++i)
-    for (const int node : { rows[i].a, rows[i].b })
-      load = std::max(load,
-                      h * h * tension[i] * inverse_mass[node] / std::max(rows[i].rest_length, kMinSpringLength));
-  const auto outer = [&](std::size_t i, std::size_t next) {
-    return rows[i].a == rows[next].a || rows[i].a == rows[next].b ? rows[i].b : rows[i].a;
-  };
-  const bool bounded = count > 1 && inverse_mass[outer(0, 1)] == 0.0 && inverse_mass[outer(count - 1, count - 2)] == 0.0;
-  if (even && load > kEvenLoad)
-    return kLoaded;
   // The lumped stiffness's known part (see the class comment) only on even chains: on the heavy chain of
   // hard case 2 it broke two bounds (a pendulum's segment strain 1.04 % > 1 %, and the folded chain
   // snapping taut gained 0.66 J), and a heavy chain hangs nearly straight, where P g, the bias it
@@ -418,6 +418,22 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
   return true;
 }
 
+[[gnu::always_inline]] inline ChainSolver::NodeMobility ChainSolver::nodeMobility(double w, double left,
+                                                                                  double right, double s)
+{
+  if (w == 0.0)
+    return NodeMobility{ 0.0, 0.0, 0.0, 0.0, s };
+  // Without tension M~ = m I: w I exactly, as the Gauss-Seidel update uses.
+  if (left == 0.0 && right == 0.0)
+    return NodeMobility{ w, 0.0, 0.0, 0.0, s };
+  // In units of the node's mass: a = w g_l, b = w g_r, c = 1 + a + b, D = (1 + a)(1 + b) - a b s^2 > 0.
+  const double a = w * left;
+  const double b = w * right;
+  const double d = (1.0 + a) * (1.0 + b) - a * b * s * s;
+  const double f = w / ((1.0 + a + b) * d);
+  return NodeMobility{ d * f, a * (1.0 + a) * f, a * b * s * f, b * (1.0 + b) * f, s };
+}
+
 bool ChainSolver::freeStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
                            const NodeArray& x_prev, double h, const NodeArray* correction, bool bounded, NodeArray& x,
                            double* lambda)
@@ -502,21 +518,6 @@ bool ChainSolver::freeStep(const SweepRow* rows, std::size_t count, const Eigen:
     x.col(path_[p]) += correction != nullptr ? Vec3(node_step_.col(column(p)) + node_push_.col(column(p)))
                                              : Vec3(node_step_.col(column(p)));
   return true;
-}
-
-ChainSolver::NodeMobility ChainSolver::nodeMobility(double w, double left, double right, double s)
-{
-  if (w == 0.0)
-    return NodeMobility{ 0.0, 0.0, 0.0, 0.0, s };
-  // Without tension M~ = m I: w I exactly, as the Gauss-Seidel update uses.
-  if (left == 0.0 && right == 0.0)
-    return NodeMobility{ w, 0.0, 0.0, 0.0, s };
-  // In units of the node's mass: a = w g_l, b = w g_r, c = 1 + a + b, D = (1 + a)(1 + b) - a b s^2 > 0.
-  const double a = w * left;
-  const double b = w * right;
-  const double d = (1.0 + a) * (1.0 + b) - a * b * s * s;
-  const double f = w / ((1.0 + a + b) * d);
-  return NodeMobility{ d * f, a * (1.0 + a) * f, a * b * s * f, b * (1.0 + b) * f, s };
 }
 
 ChainSolver::Matrix3 ChainSolver::mobility(const SweepRow* rows, std::size_t count, std::size_t i, int node,

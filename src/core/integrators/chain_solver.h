@@ -159,13 +159,14 @@ private:
   /// Row i's step of the Thomas algorithm's forward elimination.
   void eliminate(std::size_t i, std::size_t count);
 
-  /// newtonStep without contacts, in one pass along the chain (`correction` null: no known forces).
+  /// newtonStep without contacts, in short passes along the chain (`correction` null: no known forces).
   bool freeStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
                 double h, const NodeArray* correction, bool bounded, NodeArray& x, double* lambda);
 
-  /// W~ = M~^-1 at a node of the path without contacts, where M~ = m I + g_l (I - u_l u_l^T) + g_r (I - u_r u_r^T)
-  /// (g_l, g_r the lumped geometric stiffness of the rows to its left and right along the path, u_l, u_r their
-  /// directions; g = 0 and u = 0 where there is no such row). M~ is c I - U G U^T with c = m + g_l + g_r,
+  /// W~ = M~^-1 at a node of the path without contacts, where
+  ///   M~ = m I + g_l (I - u_l u_l^T) + g_r (I - u_r u_r^T)
+  /// (g_l, g_r the lumped geometric stiffness of the rows to its left and right along the path, u_l, u_r
+  /// their directions; g = 0 and u = 0 where there is no such row). M~ is c I - U G U^T with c = m + g_l + g_r,
   /// U = [u_l u_r], G = diag(g_l, g_r), and by the Woodbury identity
   ///   W~ = I / c + U K U^T,   K = 1 / (c D) [g_l (m + g_l), g_l g_r s; g_l g_r s, g_r (m + g_r)],
   ///   D = (m + g_l)(m + g_r) - g_l g_r s^2 > 0,   s = u_l . u_r:
