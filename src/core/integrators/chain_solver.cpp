@@ -177,12 +177,30 @@ void ChainSolver::reserve(std::size_t rows)
   step_b_.resize(3, n);
   upper_.resize(rows);
   delta_.resize(rows);
+  path_.resize(rows + 1);
+  node_push_.resize(3, n + 1);
+  node_step_.resize(3, n + 1);
+  a_leads_.resize(rows);
+  node_mobility_.resize(rows + 1);
 }
 
 ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
                         const NodeArray& x_prev, double h, const double* tension, bool heavy,
                         const NodeHolds* holds, const NodeArray* correction, bool push, NodeArray& x, double* lambda)
 {
+  // An even chain whose tension impulse rivals its nodes' masses is refused (see the class comment): the
+  // load h^2 T w / l exceeds kEvenLoad at a node of a row, compared without a division.
+  const bool even = !heavy;
+  bool loaded = false;
+  for (std::size_t i = 0; even && i < count; ++i)
+    loaded |= h * h * tension[i] * std::max(inverse_mass[rows[i].a], inverse_mass[rows[i].b]) >
+              kEvenLoad * std::max(rows[i].rest_length, kMinSpringLength);
+  if (loaded)
+    return kLoaded;
+  const auto outer = [&](std::size_t i, std::size_t next) {
+    return rows[i].a == rows[next].a || rows[i].a == rows[next].b ? rows[i].b : rows[i].a;
+  };
+  const bool bounded = count > 1 && inverse_mass[outer(0, 1)] == 0.0 && inverse_mass[outer(count - 1, count - 2)] == 0.0;
   for (std::size_t i = 0; i < count; ++i)
   {
     start_a_.col(static_cast<Eigen::Index>(i)) = x.col(rows[i].a);
@@ -190,19 +208,6 @@ ChainSolver::Outcome ChainSolver::solve(const SweepRow* rows, std::size_t count,
     start_lambda_[i] = lambda[i];
     estimate_[i] = tension[i];
   }
-  // An even chain whose tension impulse rivals its nodes' masses is refused (see the class comment).
-  const bool even = !heavy;
-  double load = 0.0;
-  for (std::size_t i = 0; even && i < count; ++i)
-    for (const int node : { rows[i].a, rows[i].b })
-      load = std::max(load,
-                      h * h * tension[i] * inverse_mass[node] / std::max(rows[i].rest_length, kMinSpringLength));
-  const auto outer = [&](std::size_t i, std::size_t next) {
-    return rows[i].a == rows[next].a || rows[i].a == rows[next].b ? rows[i].b : rows[i].a;
-  };
-  const bool bounded = count > 1 && inverse_mass[outer(0, 1)] == 0.0 && inverse_mass[outer(count - 1, count - 2)] == 0.0;
-  if (even && load > kEvenLoad)
-    return kLoaded;
   // The lumped stiffness's known part (see the class comment) only on even chains: on the heavy chain of
   // hard case 2 it broke two bounds (a pendulum's segment strain 1.04 % > 1 %, and the folded chain
   // snapping taut gained 0.66 J), and a heavy chain hangs nearly straight, where P g, the bias it
@@ -239,33 +244,64 @@ void ChainSolver::restart(const SweepRow* rows, std::size_t count, NodeArray& x,
   }
 }
 
+// Inlined into both steps' loops: called, they cost the chain solve 10 % (measured).
+[[gnu::always_inline]] inline void ChainSolver::evaluateRow(const SweepRow& row, std::size_t i,
+                                                            const NodeArray& x_prev, double h, const NodeArray& x,
+                                                            double lambda)
+{
+  // The row at the current positions (as projectDistance, but every row at the same x): its direction,
+  // its right-hand side -C - alpha~ lambda - gamma u . ((x_a - x_prev_a) - (x_b - x_prev_b)), and its
+  // lumped geometric stiffness 2 h^2 T / l [kg] (see the class comment).
+  const Eigen::Index column = static_cast<Eigen::Index>(i);
+  direction_.col(column).setZero();
+  rhs_[i] = 0.0;
+  geometric_[i] = 0.0;
+  if (row.inverse_denominator == 0.0)
+    return;  // both ends pinned: dlambda = 0
+  const Vec3 d = x.col(row.a) - x.col(row.b);
+  const double length = d.norm();
+  if (length < kMinSpringLength)
+    return;  // coincident nodes: the direction is undefined
+  const double inverse_length = 1.0 / length;
+  const Vec3 u = d * inverse_length;
+  direction_.col(column) = u;
+  const double c_rate_h =
+      row.gamma == 0.0 ? 0.0 : u.dot((x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b)));
+  rhs_[i] = -(length - row.rest_length) - row.alpha_tilde * lambda - row.gamma * c_rate_h;
+  geometric_[i] = 2.0 * h * h * estimate_[i] * inverse_length;
+}
+
+[[gnu::always_inline]] inline void ChainSolver::eliminate(std::size_t i, std::size_t count)
+{
+  // Thomas algorithm (LDL^T of a tridiagonal matrix, LU where it is unsymmetric): for a symmetric positive
+  // definite matrix it is stable without pivoting and every pivot is positive; friction's unsymmetric part
+  // is at most mu times a sliding node's normal coupling. With a free end the rows are independent, so a
+  // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); pinned at both ends, the
+  // last one vanishes where the chain is straight (partitionRows). One within the round-off of the
+  // subtraction that made it is treated as zero: its row keeps dlambda = 0 and the others are solved
+  // without it, rather than divided by noise.
+  constexpr double kPivotFloor = 64.0 * std::numeric_limits<double>::epsilon();
+  const double lower = i > 0 ? coupling_below_[i - 1] : 0.0;
+  const double pivot = i > 0 ? diagonal_[i] - lower * upper_[i - 1] : diagonal_[i];
+  if (!(pivot > kPivotFloor * diagonal_[i]))
+  {
+    upper_[i] = 0.0;
+    delta_[i] = 0.0;
+    return;
+  }
+  const double inverse_pivot = 1.0 / pivot;
+  upper_[i] = i + 1 < count ? coupling_[i] * inverse_pivot : 0.0;
+  delta_[i] = (rhs_[i] - (i > 0 ? lower * delta_[i - 1] : 0.0)) * inverse_pivot;
+}
+
 bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
                              const NodeArray& x_prev, double h, const NodeHolds* holds,
                              const NodeArray* correction, bool push, bool bounded, NodeArray& x, double* lambda)
 {
-  // Each row at the current positions (as projectDistance, but every row at the same x): its direction,
-  // its right-hand side -C - alpha~ lambda - gamma u . ((x_a - x_prev_a) - (x_b - x_prev_b)), and its
-  // lumped geometric stiffness 2 h^2 T / l [kg] (see the class comment).
+  if (holds == nullptr)
+    return freeStep(rows, count, inverse_mass, x_prev, h, push ? correction : nullptr, bounded, x, lambda);
   for (std::size_t i = 0; i < count; ++i)
-  {
-    const SweepRow& row = rows[i];
-    const Eigen::Index column = static_cast<Eigen::Index>(i);
-    direction_.col(column).setZero();
-    rhs_[i] = 0.0;
-    geometric_[i] = 0.0;
-    if (row.inverse_denominator == 0.0)
-      continue;  // both ends pinned: dlambda = 0
-    const Vec3 d = x.col(row.a) - x.col(row.b);
-    const double length = d.norm();
-    if (length < kMinSpringLength)
-      continue;  // coincident nodes: the direction is undefined
-    const Vec3 u = d * (1.0 / length);
-    direction_.col(column) = u;
-    const double c_rate_h =
-        row.gamma == 0.0 ? 0.0 : u.dot((x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b)));
-    rhs_[i] = -(length - row.rest_length) - row.alpha_tilde * lambda[i] - row.gamma * c_rate_h;
-    geometric_[i] = 2.0 * h * h * estimate_[i] / length;
-  }
+    evaluateRow(rows[i], i, x_prev, h, x, lambda[i]);
   // The mobility W~ = M~^-1 at each row's two nodes (zero at a pinned one). A free node of a chain meets
   // at most two rows, consecutive ones: the node row i shares with row i - 1 has that row's mobility.
   int shared_before = -1;
@@ -343,28 +379,9 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
     coupling_[i] = sign * u.dot(shared * v);
     coupling_below_[i] = sign * v.dot(shared * u);
   }
-  // Thomas algorithm (LDL^T of a tridiagonal matrix, LU where it is unsymmetric): for a symmetric positive
-  // definite matrix it is stable without pivoting and every pivot is positive; friction's unsymmetric part
-  // is at most mu times a sliding node's normal coupling. With a free end the rows are independent, so a
-  // pivot vanishes only to round-off (a mass ratio beyond ~1e14 along the chain); pinned at both ends, the
-  // last one vanishes where the chain is straight (partitionRows). One within the round-off of the
-  // subtraction that made it is treated as zero: its row keeps dlambda = 0 and the others are solved
-  // without it, rather than divided by noise.
-  constexpr double kPivotFloor = 64.0 * std::numeric_limits<double>::epsilon();
+  // Thomas algorithm (eliminate()).
   for (std::size_t i = 0; i < count; ++i)
-  {
-    const double lower = i > 0 ? coupling_below_[i - 1] : 0.0;
-    const double pivot = i > 0 ? diagonal_[i] - lower * upper_[i - 1] : diagonal_[i];
-    if (!(pivot > kPivotFloor * diagonal_[i]))
-    {
-      upper_[i] = 0.0;
-      delta_[i] = 0.0;
-      continue;
-    }
-    const double inverse_pivot = 1.0 / pivot;
-    upper_[i] = i + 1 < count ? coupling_[i] * inverse_pivot : 0.0;
-    delta_[i] = (rhs_[i] - (i > 0 ? lower * delta_[i - 1] : 0.0)) * inverse_pivot;
-  }
+    eliminate(i, count);
   for (std::size_t i = count - 1; i-- > 0;)
     delta_[i] -= upper_[i] * delta_[i + 1];
   // x += W~ J^T dlambda, row by row; on a chain pinned at both ends (`bounded`) only if no node moves by
@@ -398,6 +415,108 @@ bool ChainSolver::newtonStep(const SweepRow* rows, std::size_t count, const Eige
       if (first_time(row.b))
         x.col(row.b) += push_b_.col(static_cast<Eigen::Index>(i));
     }
+  return true;
+}
+
+[[gnu::always_inline]] inline ChainSolver::NodeMobility ChainSolver::nodeMobility(double w, double left,
+                                                                                  double right, double s)
+{
+  if (w == 0.0)
+    return NodeMobility{ 0.0, 0.0, 0.0, 0.0, s };
+  // Without tension M~ = m I: w I exactly, as the Gauss-Seidel update uses.
+  if (left == 0.0 && right == 0.0)
+    return NodeMobility{ w, 0.0, 0.0, 0.0, s };
+  // In units of the node's mass: a = w g_l, b = w g_r, c = 1 + a + b, D = (1 + a)(1 + b) - a b s^2 > 0.
+  const double a = w * left;
+  const double b = w * right;
+  const double d = (1.0 + a) * (1.0 + b) - a * b * s * s;
+  const double f = w / ((1.0 + a + b) * d);
+  return NodeMobility{ d * f, a * (1.0 + a) * f, a * b * s * f, b * (1.0 + b) * f, s };
+}
+
+bool ChainSolver::freeStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass,
+                           const NodeArray& x_prev, double h, const NodeArray* correction, bool bounded, NodeArray& x,
+                           double* lambda)
+{
+  // newtonStep without contacts, node by node along the path (path_[p] joins rows p - 1 and p), in short
+  // passes: the rows, each on its own; the nodes' mobility (NodeMobility) and known displacement, each from
+  // its two rows; the system and its elimination, the one pass where each row waits for the last.
+  const auto column = [](std::size_t i) { return static_cast<Eigen::Index>(i); };
+  for (std::size_t i = 0; i < count; ++i)
+  {
+    // Row i joins path_[i] and path_[i + 1]: the node it shares with row i + 1 is its second.
+    const SweepRow& row = rows[i];
+    a_leads_[i] = i + 1 < count ? row.a != rows[i + 1].a && row.a != rows[i + 1].b : i == 0 || row.a == path_[i];
+    if (i == 0)
+      path_[0] = a_leads_[0] ? row.a : row.b;
+    path_[i + 1] = a_leads_[i] ? row.b : row.a;
+    evaluateRow(row, i, x_prev, h, x, lambda[i]);
+    // The lag of the lumped stiffness, h^2 T / l P (c_a + c_b) on each node (newtonStep).
+    lag_.col(column(i)).setZero();
+    if (correction != nullptr && geometric_[i] != 0.0)
+    {
+      const Vec3 u = direction_.col(column(i));
+      const Vec3 sum = correction->col(row.a) + correction->col(row.b);
+      lag_.col(column(i)) = 0.5 * geometric_[i] * (sum - u * u.dot(sum));
+    }
+  }
+  for (std::size_t p = 0; p <= count; ++p)
+  {
+    const Vec3 u_left = p > 0 ? Vec3(direction_.col(column(p - 1))) : Vec3::Zero();
+    const Vec3 u_right = p < count ? Vec3(direction_.col(column(p))) : Vec3::Zero();
+    const NodeMobility node = nodeMobility(inverse_mass[path_[p]], p > 0 ? geometric_[p - 1] : 0.0,
+                                           p < count ? geometric_[p] : 0.0, u_left.dot(u_right));
+    node_mobility_[p] = node;
+    if (correction == nullptr)
+      continue;
+    const Vec3 lag = p == 0 ? Vec3(lag_.col(0)) : p == count ? Vec3(lag_.col(column(p - 1)))
+                                                          : Vec3(lag_.col(column(p - 1)) + lag_.col(column(p)));
+    node_push_.col(column(p)) = node.times(u_left, u_right, lag);
+  }
+  // Row r is the right-hand row of path node r and the left-hand row of node r + 1 (see newtonStep for the
+  // system), eliminated as it is made.
+  for (std::size_t r = 0; r < count; ++r)
+  {
+    const SweepRow& row = rows[r];
+    const Vec3 u = direction_.col(column(r));
+    const NodeMobility& node = node_mobility_[r + 1];
+    if (correction != nullptr)
+      rhs_[r] -= (a_leads_[r] ? 1.0 : -1.0) * u.dot(node_push_.col(column(r)) - node_push_.col(column(r + 1)));
+    const double scale = row.gamma == 0.0 ? 1.0 : 1.0 / (1.0 + row.gamma);
+    rhs_[r] *= scale;
+    diagonal_[r] = u.isZero(0.0) ? 1.0 : node_mobility_[r].rightRight() + node.leftLeft() + row.alpha_tilde * scale;
+    // The signs of gradC at the shared node: +u at a row's node a, -u at its node b.
+    coupling_[r] =
+        r + 1 < count ? (a_leads_[r] ? -1.0 : 1.0) * (a_leads_[r + 1] ? 1.0 : -1.0) * node.leftRight() : 0.0;
+    coupling_below_[r] = coupling_[r];
+    eliminate(r, count);
+  }
+  for (std::size_t i = count - 1; i-- > 0;)
+    delta_[i] -= upper_[i] * delta_[i + 1];
+  // x += W~ J^T dlambda, node by node: gradC is +u at a row's node a, -u at its node b. On a chain pinned at
+  // both ends (`bounded`) only if no row moves a node by more than kReach rest lengths: else nothing is changed.
+  for (std::size_t p = 0; p <= count; ++p)
+  {
+    const NodeMobility& node = node_mobility_[p];
+    const Vec3 u_l = p > 0 ? Vec3(direction_.col(column(p - 1))) : Vec3::Zero();
+    const Vec3 u_r = p < count ? Vec3(direction_.col(column(p))) : Vec3::Zero();
+    const Vec3 by_left =
+        p > 0 ? node.leftTimes(u_l, u_r, (a_leads_[p - 1] ? -1.0 : 1.0) * delta_[p - 1]) : Vec3::Zero();
+    const Vec3 by_right = p < count ? node.rightTimes(u_l, u_r, (a_leads_[p] ? 1.0 : -1.0) * delta_[p]) : Vec3::Zero();
+    if (bounded)
+    {
+      const double reach_left = p > 0 ? kReach * rows[p - 1].rest_length : 0.0;
+      const double reach_right = p < count ? kReach * rows[p].rest_length : 0.0;
+      if (by_left.squaredNorm() > reach_left * reach_left || by_right.squaredNorm() > reach_right * reach_right)
+        return false;
+    }
+    node_step_.col(column(p)) = by_left + by_right;
+  }
+  for (std::size_t i = 0; i < count; ++i)
+    lambda[i] += delta_[i];
+  for (std::size_t p = 0; p <= count; ++p)
+    x.col(path_[p]) += correction != nullptr ? Vec3(node_step_.col(column(p)) + node_push_.col(column(p)))
+                                             : Vec3(node_step_.col(column(p)));
   return true;
 }
 

@@ -152,6 +152,57 @@ private:
                   double h, const NodeHolds* holds, const NodeArray* correction, bool push, bool bounded,
                   NodeArray& x, double* lambda);
 
+  /// The row's direction, right-hand side and lumped geometric stiffness at the current positions.
+  void evaluateRow(const SweepRow& row, std::size_t i, const NodeArray& x_prev, double h, const NodeArray& x,
+                   double lambda);
+
+  /// Row i's step of the Thomas algorithm's forward elimination.
+  void eliminate(std::size_t i, std::size_t count);
+
+  /// newtonStep without contacts, in short passes along the chain (`correction` null: no known forces).
+  bool freeStep(const SweepRow* rows, std::size_t count, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+                double h, const NodeArray* correction, bool bounded, NodeArray& x, double* lambda);
+
+  /// W~ = M~^-1 at a node of the path without contacts, where
+  ///   M~ = m I + g_l (I - u_l u_l^T) + g_r (I - u_r u_r^T)
+  /// (g_l, g_r the lumped geometric stiffness of the rows to its left and right along the path, u_l, u_r
+  /// their directions; g = 0 and u = 0 where there is no such row). M~ is c I - U G U^T with c = m + g_l + g_r,
+  /// U = [u_l u_r], G = diag(g_l, g_r), and by the Woodbury identity
+  ///   W~ = I / c + U K U^T,   K = 1 / (c D) [g_l (m + g_l), g_l g_r s; g_l g_r s, g_r (m + g_r)],
+  ///   D = (m + g_l)(m + g_r) - g_l g_r s^2 > 0,   s = u_l . u_r:
+  /// one division per node instead of a 3 x 3 inverse, and products with u_l and u_r in a few scalars.
+  struct NodeMobility
+  {
+    double inverse;  ///< 1 / c [1/kg]
+    double ll;       ///< K's entries [1/kg]
+    double lr;
+    double rr;
+    double s;        ///< u_l . u_r
+
+    Vec3 times(const Vec3& left, const Vec3& right, const Vec3& v) const
+    {
+      const double pl = left.dot(v);
+      const double pr = right.dot(v);
+      return inverse * v + (ll * pl + lr * pr) * left + (lr * pl + rr * pr) * right;
+    }
+    /// W~ (alpha u_l) and W~ (beta u_r).
+    Vec3 leftTimes(const Vec3& left, const Vec3& right, double alpha) const
+    {
+      return alpha * ((inverse + ll + lr * s) * left + (lr + rr * s) * right);
+    }
+    Vec3 rightTimes(const Vec3& left, const Vec3& right, double beta) const
+    {
+      return beta * ((ll * s + lr) * left + (inverse + lr * s + rr) * right);
+    }
+    double leftLeft() const { return inverse + ll + s * (2.0 * lr + rr * s); }     ///< u_l . W~ u_l
+    double rightRight() const { return inverse + rr + s * (2.0 * lr + ll * s); }   ///< u_r . W~ u_r
+    double leftRight() const { return (inverse + ll + rr) * s + lr * (1.0 + s * s); }  ///< u_l . W~ u_r
+  };
+
+  /// W~ at a free node of inverse mass w [1/kg] (0: pinned) between rows of geometric stiffness left and
+  /// right [kg] whose directions make s = u_l . u_r.
+  static NodeMobility nodeMobility(double w, double left, double right, double s);
+
   /// Puts the chain's nodes and lambdas back where solve() found them.
   void restart(const SweepRow* rows, std::size_t count, NodeArray& x, double* lambda) const;
 
@@ -165,7 +216,7 @@ private:
   std::vector<double> estimate_;  ///< the tension T_i the geometric stiffness uses [N]
   NodeArray direction_;           ///< u_i, zero for a row that cannot move
   std::vector<double> geometric_;  ///< the lumped geometric stiffness 2 h^2 T_i / l_i [kg]
-  std::vector<Matrix3> mobility_a_;  ///< W~ at each row's node a [1/kg]
+  std::vector<Matrix3> mobility_a_;  ///< W~ at each row's node a [1/kg], with contacts
   std::vector<Matrix3> mobility_b_;  ///< ... and at its node b
   std::vector<double> diagonal_;
   std::vector<double> coupling_;        ///< (J W~ J^T)_{i,i+1}
@@ -178,6 +229,11 @@ private:
   NodeArray step_b_;              ///< ... and of its node b
   std::vector<double> upper_;     ///< the Thomas algorithm's modified super-diagonal c'_i
   std::vector<double> delta_;     ///< its modified right-hand side d'_i, then dlambda_i
+  std::vector<int> path_;         ///< the chain's nodes in path order: row i joins path_[i] and path_[i + 1]
+  std::vector<std::uint8_t> a_leads_;  ///< per row: 1 if its node a is path_[i]
+  std::vector<NodeMobility> node_mobility_;  ///< W~ per node of the path, without contacts
+  NodeArray node_step_;           ///< per node of the path, W~ J^T dlambda, without contacts [m]
+  NodeArray node_push_;           ///< per node of the path, its known displacement in the first step [m]
 };
 
 }  // namespace soft_body_sim
