@@ -4,7 +4,8 @@
 Reads from OUT: work_precision.csv, best_cost.csv, ratios.csv, demo.csv (work_precision),
 bench_step.json (Google Benchmark), memory.csv (memory_footprint). Writes into OUT:
   work_precision.png         error against cost, log-log, one panel per problem (its first error kind)
-  work_precision_more.png    the same for the second error kind (strain, energy drift, penetration)
+  work_precision_more.png    the same for the second error kind (strain, energy drift, penetration), and
+                             the problems of one error kind that show all node counts in one panel (rod)
   scaling.png                step cost against node count, with the fitted log-log slope
   summary.md                 the tables docs/RESULTS.md shows
 """
@@ -43,6 +44,11 @@ PANELS = [
     ("cloth", 1024, "4. cloth 32 x 32"),
     ("jelly", 49, "5. jelly dropped on the floor"),
 ]
+# Problems of one error kind swept over node counts: one panel in work_precision_more.png with every node
+# count (each engine's front across them, its points labelled by node count), one table per problem.
+ALL_NODES_PANELS = [
+    ("rod_cantilever", "6. rod cantilever (elastica)"),
+]
 UNITS = {
     "final_position": "m", "max_node_distance": "m", "end_point_distance": "m", "penetration": "m",
     "max_strain": "-", "energy_drift": "of M g L", "cell_area": "of the area",
@@ -57,21 +63,28 @@ def read_csv(path):
 
 
 def pareto(points):
-    """The points no other point beats in both cost and error, by rising cost."""
+    """The points (cost, error, ...) no other point beats in both cost and error, by rising cost."""
     front = []
-    for cost, error in sorted(points):
-        if not front or error < front[-1][1]:
-            front.append((cost, error))
+    for point in sorted(points):
+        if not front or point[1] < front[-1][1]:
+            front.append(point)
     return front
 
 
-def plot_work_precision(rows, kind_index, path):
+def plot_work_precision(rows, kind_index, path, all_nodes_panels=()):
+    """One panel per PANELS entry with an error kind number kind_index, then one per all_nodes_panels entry
+    (its first error kind, every node count; nodes None)."""
     kinds = {}
     for row in rows:
-        kinds.setdefault((row["problem"], int(row["n_nodes"])), [])
-        if row["error_kind"] not in kinds[(row["problem"], int(row["n_nodes"]))]:
-            kinds[(row["problem"], int(row["n_nodes"]))].append(row["error_kind"])
-    panels = [p for p in PANELS if len(kinds.get((p[0], p[1]), [])) > kind_index]
+        for key in ((row["problem"], int(row["n_nodes"])), (row["problem"], None)):
+            kinds.setdefault(key, [])
+            if row["error_kind"] not in kinds[key]:
+                kinds[key].append(row["error_kind"])
+    panels = [(p[0], p[1], p[2], kind_index) for p in PANELS if len(kinds.get((p[0], p[1]), [])) > kind_index]
+    for problem, title in all_nodes_panels:
+        counts = sorted({int(r["n_nodes"]) for r in rows if r["problem"] == problem})
+        if counts:
+            panels.append((problem, None, "%s, %d to %d nodes" % (title, counts[0], counts[-1]), 0))
     if not panels:
         return
     columns = 3
@@ -79,12 +92,12 @@ def plot_work_precision(rows, kind_index, path):
     figure, axes = plt.subplots(lines, columns, figsize=(5.2 * columns, 4.2 * lines), squeeze=False)
     for axis in axes.flat[len(panels):]:
         axis.set_visible(False)
-    for axis, (problem, nodes, title) in zip(axes.flat, panels):
-        kind = kinds[(problem, nodes)][kind_index]
+    for axis, (problem, nodes, title, index) in zip(axes.flat, panels):
+        kind = kinds[(problem, nodes)][index]
         for engine in ENGINES:
-            points = [(float(r["cpu_s_per_sim_s"]), float(r["error"])) for r in rows
-                      if r["problem"] == problem and int(r["n_nodes"]) == nodes and r["integrator"] == engine
-                      and r["error_kind"] == kind and r["error"] not in ("inf", "nan")
+            points = [(float(r["cpu_s_per_sim_s"]), float(r["error"]), int(r["n_nodes"])) for r in rows
+                      if r["problem"] == problem and (nodes is None or int(r["n_nodes"]) == nodes)
+                      and r["integrator"] == engine and r["error_kind"] == kind and r["error"] not in ("inf", "nan")
                       and r["cpu_s_per_sim_s"] != "nan" and float(r["error"]) > 0]
             if not points:
                 continue
@@ -94,6 +107,10 @@ def plot_work_precision(rows, kind_index, path):
             axis.plot([p[0] for p in front], [p[1] for p in front], color=color, marker=marker, markersize=5,
                       linewidth=1.6 if engine in ("xpbd", "bullet", "implicit_euler") else 1.0,
                       label="Bullet (btSoftBody)" if engine == "bullet" else engine)
+            if nodes is None:
+                for cost, error, n in front:
+                    axis.annotate(str(n), (cost, error), textcoords="offset points", xytext=(3, 3), fontsize=6,
+                                  color=color)
         if problem.startswith("hanging_chain") and kind == "max_node_distance":
             axis.axhline(1e-3, color="gray", linestyle="--", linewidth=0.8)
         axis.set_xscale("log")
@@ -204,8 +221,13 @@ def summary(out, slopes, per_spring):
     levels = ["0.1", "0.01", "0.001", "0.0001", "1e-05", "1e-06"]
     lines.append("### Best cost at each error level [CPU s per simulated s]\n")
     lines.append("The cheapest configuration of each engine whose error is at most the level "
-                 "(– = none reaches it; configuration as dt [s] / sub-steps / iterations).\n")
-    for problem, nodes, title in PANELS:
+                 "(– = none reaches it; configuration as dt [s] / sub-steps / iterations, and for Bullet's "
+                 "bending links their kLST).\n")
+    tables = list(PANELS)
+    for problem, title in ALL_NODES_PANELS:
+        for n in sorted({int(r["n_nodes"]) for r in rows if r["problem"] == problem}):
+            tables.append((problem, n, "%s, %d nodes" % (title, n)))
+    for problem, nodes, title in tables:
         kinds = []
         for r in rows:
             if r["problem"] == problem and int(r["n_nodes"]) == nodes and r["error_kind"] not in kinds:
@@ -224,7 +246,9 @@ def summary(out, slopes, per_spring):
                 if match:
                     b = match[0]
                     seen = True
-                    cells.append("%s (%s/%s/%s)" % (fmt(b["cpu_s_per_sim_s"]), fmt(b["dt"]), b["substeps"], b["iterations"]))
+                    stiffness = ", kLST %s" % fmt(b["bending_kLST"]) if b.get("bending_kLST") else ""
+                    cells.append("%s (%s/%s/%s%s)" % (fmt(b["cpu_s_per_sim_s"]), fmt(b["dt"]), b["substeps"],
+                                                      b["iterations"], stiffness))
                 else:
                     cells.append("–")
             if seen or any(r["integrator"] == engine and r["problem"] == problem for r in rows):
@@ -277,7 +301,7 @@ def main():
     out = sys.argv[1]
     rows = read_csv(os.path.join(out, "work_precision.csv"))
     plot_work_precision(rows, 0, os.path.join(out, "work_precision.png"))
-    plot_work_precision(rows, 1, os.path.join(out, "work_precision_more.png"))
+    plot_work_precision(rows, 1, os.path.join(out, "work_precision_more.png"), ALL_NODES_PANELS)
     slopes, per_spring = scaling(out)
     summary(out, slopes, per_spring)
     print("plots and summary.md written to %s" % out)

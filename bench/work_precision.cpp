@@ -2,9 +2,11 @@
 // side with Bullet's soft bodies (see docs/RESULTS.md; `scripts/bench OUT` runs it and plots).
 //   work_precision OUT [--quick] [--only NAME] [--demo SCENE] [--no-bullet]
 // Writes into the folder OUT:
-//   work_precision.csv  problem,integrator,n_nodes,dt,substeps,iterations,cpu_s_per_sim_s,error,error_kind
-//                       (one row per configuration and error kind; error inf = diverged, cost nan then)
+//   work_precision.csv  problem,integrator,n_nodes,dt,substeps,iterations,cpu_s_per_sim_s,error,error_kind,
+//                       bending_kLST (one row per configuration and error kind; error inf = diverged, cost
+//                       nan then; bending_kLST: Bullet's bending links' stiffness, empty where none)
 //   best_cost.csv       the cheapest configuration per engine at each error level
+// --only NAME makes and runs only the problems whose name contains NAME (e.g. rod_cantilever).
 //   ratios.csv          the hanging chain at 1 mm: this package's best against Bullet's best
 //   demo.csv            the demo scene's physics cost
 //   machine.txt         where it ran
@@ -139,6 +141,9 @@ std::string formatDouble(double value)
   return text;
 }
 
+/// The value, or nothing where it is NaN (a setting the run does not have).
+std::string optionalDouble(double value) { return std::isnan(value) ? std::string() : formatDouble(value); }
+
 struct Row
 {
   std::string problem;
@@ -247,7 +252,7 @@ int run(int argc, char** argv)
     else if (arg == "--no-bullet")
       use_bullet = false;
     else if (arg == "--only" && i + 1 < argc)
-      only = argv[++i];
+      only = options.only = argv[++i];
     else if (arg == "--demo" && i + 1 < argc)
       demo = argv[++i];
     else if (!arg.empty() && arg[0] != '-' && out_dir.empty())
@@ -273,7 +278,7 @@ int run(int argc, char** argv)
 
   std::vector<Problem> problems = makeProblems(options);
   std::ofstream csv(out_dir + "/work_precision.csv");
-  csv << "problem,integrator,n_nodes,dt,substeps,iterations,cpu_s_per_sim_s,error,error_kind\n";
+  csv << "problem,integrator,n_nodes,dt,substeps,iterations,cpu_s_per_sim_s,error,error_kind,bending_kLST\n";
   std::vector<Row> rows;
   for (const Problem& problem : problems)
   {
@@ -301,7 +306,8 @@ int run(int argc, char** argv)
       for (std::size_t k = 0; k < problem.error_kinds.size(); ++k)
         csv << problem.name << "," << config.integrator << "," << problem.n_nodes << "," << formatDouble(config.dt) << ","
             << config.substeps << "," << config.iterations << "," << formatDouble(m.cost) << ","
-            << formatDouble(m.errors[k]) << "," << problem.error_kinds[k] << "\n";
+            << formatDouble(m.errors[k]) << "," << problem.error_kinds[k] << ","
+            << optionalDouble(config.bending_stiffness) << "\n";
       csv.flush();
       rows.push_back({ problem.name, problem.n_nodes, m });
     }
@@ -311,14 +317,18 @@ int run(int argc, char** argv)
 
   // Best cost per engine at each error level, and the table.
   std::ofstream best(out_dir + "/best_cost.csv");
-  best << "problem,n_nodes,error_kind,error_level,engine,cpu_s_per_sim_s,dt,substeps,iterations,error\n";
+  best << "problem,n_nodes,error_kind,error_level,engine,cpu_s_per_sim_s,dt,substeps,iterations,error,bending_kLST\n";
   const std::vector<double> levels = { 1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6 };
   std::printf("\nBest cost [CPU s per simulated s] reaching each error level (- = none does)\n");
   for (const Problem& problem : problems)
   {
     if (!only.empty() && problem.name.find(only) == std::string::npos)
       continue;
-    std::vector<std::string> engines = integratorNames();
+    // The engines that ran it (a rod runs under implicit_euler only).
+    std::vector<std::string> engines;
+    for (const std::string& engine : integratorNames())
+      if (std::any_of(problem.sweep.begin(), problem.sweep.end(), [&](const Config& c) { return c.integrator == engine; }))
+        engines.push_back(engine);
     if (problem.bullet && use_bullet && bulletAvailable())
       engines.push_back("bullet");
     for (std::size_t kind = 0; kind < problem.error_kinds.size(); ++kind)
@@ -338,7 +348,7 @@ int run(int argc, char** argv)
             best << problem.name << "," << problem.n_nodes << "," << problem.error_kinds[kind] << "," << level << ","
                  << engine << "," << formatDouble(row->m.cost) << "," << formatDouble(row->m.config.dt) << ","
                  << row->m.config.substeps << "," << row->m.config.iterations << "," << formatDouble(row->m.errors[kind])
-                 << "\n";
+                 << "," << optionalDouble(row->m.config.bending_stiffness) << "\n";
         }
         std::printf("\n");
       }
@@ -350,7 +360,8 @@ int run(int argc, char** argv)
   ratios << "problem,n_nodes,package_engine,package_dt,package_substeps,package_iterations,package_cost,"
             "bullet_dt,bullet_iterations,bullet_cost,ratio,package_cost_interpolated,bullet_cost_interpolated,"
             "ratio_interpolated\n";
-  std::printf("\nHanging chain, max node error <= 1 mm: this package's best against Bullet's best\n");
+  if (std::any_of(problems.begin(), problems.end(), [](const Problem& p) { return p.name.rfind("hanging_chain", 0) == 0; }))
+    std::printf("\nHanging chain, max node error <= 1 mm: this package's best against Bullet's best\n");
   for (const Problem& problem : problems)
   {
     if (problem.name.rfind("hanging_chain", 0) != 0 || (!only.empty() && problem.name.find(only) == std::string::npos))

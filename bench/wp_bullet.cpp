@@ -27,12 +27,19 @@ public:
     info_.m_sparsesdf.Initialize();
     // Straight along x and at rest: every link's rest length is length / (nodes - 1), like ours.
     body_.reset(btSoftBodyHelpers::CreateRope(info_, btVector3(0, 0, 0), btVector3(rope.length, 0, 0), rope.nodes - 2, 0));
+    // Bending links take their rest length from the nodes now: straight, 2 l apart for d = 2.
+    if (rope.bending_distance >= 2)
+    {
+      btSoftBody::Material* bending = body_->appendMaterial();
+      bending->m_kLST = config.bending_stiffness;
+      body_->generateBendingConstraints(rope.bending_distance, bending);
+    }
     for (int i = 0; i < rope.nodes; ++i)
     {
       btSoftBody::Node& node = body_->m_nodes[i];
       node.m_x = node.m_q = btVector3(rope.start(0, i), rope.start(1, i), rope.start(2, i));
       node.m_v = btVector3(0, 0, 0);
-      body_->setMass(i, rope.node_mass);
+      body_->setMass(i, rope.masses.empty() ? rope.node_mass : rope.masses[static_cast<std::size_t>(i)]);
     }
     for (int i : rope.pinned)
       body_->setMass(i, 0);

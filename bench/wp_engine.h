@@ -22,13 +22,17 @@ inline double cpuSeconds()
 }
 
 /// How a run is stepped: an integrator of this package (or "bullet"), the step dt [s], sub-steps per
-/// step and iterations (for Bullet: its position-solver iterations, piterations).
+/// step and iterations (for Bullet: its position-solver iterations, piterations); for a Bullet rope with
+/// bending links, their stiffness.
 struct Config
 {
   std::string integrator;
   double dt = 0.01;
   int substeps = 1;
   int iterations = 1;
+  /// Bullet only: kLST in (0, 1] of the rope's bending links (BulletRope::bending_distance); NaN where
+  /// the run has none.
+  double bending_stiffness = std::numeric_limits<double>::quiet_NaN();
 };
 
 class Engine

@@ -34,6 +34,10 @@ struct BulletRope
   Eigen::Matrix3Xd start;        ///< [m] initial positions
   double gravity = 9.81;         ///< [m/s^2] along -z
   double drag = 0.0;             ///< [1/s]: Bullet's kDP = 1 - exp(-drag dt) per step
+  std::vector<double> masses;    ///< [kg] per node, if given: instead of node_mass
+  /// 0: links between neighbours only. d >= 2: also generateBendingConstraints(d), links from each node
+  /// to its d-th neighbours at their straight distance, of kLST Config::bending_stiffness.
+  int bending_distance = 0;
 };
 
 struct Problem
@@ -54,6 +58,7 @@ struct Problem
 struct ProblemOptions
 {
   bool quick = false;  ///< fewer configurations and shorter references (a smoke test)
+  std::string only;    ///< if not empty: only the problems whose name contains it (their truths only)
 };
 
 /// Every reference problem, with its truth computed (reference runs included); logs to stderr.

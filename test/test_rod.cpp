@@ -1,7 +1,7 @@
 // Rods (type: rod; rods.h, bodies/rod.h) against mechanics that does not come from our code: the
 // derivatives of the discrete rod against finite differences, and the rod against Euler-Bernoulli beam
-// theory, the elastica (solved here by shooting), Saint-Venant torsion and the cantilever's first
-// bending frequency.
+// theory, the elastica (solved by shooting: test/elastica.h, shared with the work-precision benchmark),
+// Saint-Venant torsion and the cantilever's first bending frequency.
 #include <cmath>
 #include <optional>
 #include <string>
@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "elastica.h"
 #include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/rods.h"
 #include "test_util.h"
@@ -56,54 +57,6 @@ World settledCantilever(const RodDef& def)
   World world = buildWorld(scene);
   EXPECT_TRUE(settle(world, 1e-10, 20000));
   return world;
-}
-
-/// The elastica of a cantilever under its own weight w (clamped horizontal at s = 0, free at s = L):
-/// E I theta'' = -w (L - s) cos theta, theta(0) = 0, theta'(L) = 0, theta the downward angle of the
-/// tangent; solved by shooting on theta'(0) (bisection, RK4 of `steps` steps) and integrated to the
-/// centre line (x(s), z(s)) relative to the clamp, sampled at the arc lengths `at`.
-std::vector<Eigen::Vector2d> elastica(double bending_stiffness, double weight, double length,
-                                      const std::vector<double>& at, int steps = 20000)
-{
-  const double ds = length / steps;
-  // State y = (theta, theta', x, z); returns it at every step.
-  const auto integrate = [&](double curvature, std::vector<Eigen::Vector4d>* path) {
-    Eigen::Vector4d y(0.0, curvature, 0.0, 0.0);
-    const auto rate = [&](double s, const Eigen::Vector4d& q) {
-      return Eigen::Vector4d(q[1], -weight * (length - s) * std::cos(q[0]) / bending_stiffness, std::cos(q[0]),
-                             -std::sin(q[0]));
-    };
-    if (path)
-      path->push_back(y);
-    for (int k = 0; k < steps; ++k)
-    {
-      const double s = k * ds;
-      const Eigen::Vector4d k1 = rate(s, y), k2 = rate(s + ds / 2, y + ds / 2 * k1),
-                            k3 = rate(s + ds / 2, y + ds / 2 * k2), k4 = rate(s + ds, y + ds * k3);
-      y += ds / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
-      if (path)
-        path->push_back(y);
-    }
-    return y;
-  };
-  // theta'(L) grows with theta'(0): bracket between 0 and the straight-down moment w L^2 / (2 E I).
-  double low = 0.0, high = weight * length * length / (2.0 * bending_stiffness) * 1.01;
-  for (int k = 0; k < 200 && high - low > 1e-15 * high; ++k)
-  {
-    const double mid = 0.5 * (low + high);
-    (integrate(mid, nullptr)[1] > 0.0 ? high : low) = mid;
-  }
-  std::vector<Eigen::Vector4d> path;
-  integrate(0.5 * (low + high), &path);
-  std::vector<Eigen::Vector2d> points;
-  for (double s : at)
-  {
-    const double index = s / ds;
-    const int k = std::min(static_cast<int>(index), steps - 1);
-    const double u = index - k;
-    points.push_back((1 - u) * path[k].tail<2>() + u * path[k + 1].tail<2>());
-  }
-  return points;
 }
 
 /// Max distance [m] of the settled cantilever's nodes from the elastica at the same arc length.
