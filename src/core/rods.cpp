@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace soft_body_sim
 {
@@ -59,6 +60,13 @@ Vec3 across(const Vec3& t, const Vec3& y)
   return d.normalized();
 }
 }  // namespace
+
+void requireRodIntegrator(const Model& model, IntegratorType integrator)
+{
+  if (!model.rods.empty() && integrator != IntegratorType::ImplicitEuler)
+    throw std::invalid_argument("a rod (type: rod) bends and twists only under implicit_euler, not " +
+                                integratorName(integrator));
+}
 
 int heldRodEnd(const Model& model, int node, int& end)
 {

@@ -9,6 +9,7 @@
 #include "soft_body_sim/core/stability.h"
 
 #include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/rods.h"
 
 namespace soft_body_sim
 {
@@ -195,9 +196,14 @@ World buildWorld(const SceneDef& scene)
     model.bodies.push_back({ body.name, first, count, body.self_collision, body.self_friction, body.springs_collide });
     first += count;
   }
-  if (!model.rods.empty() && scene.physics.integrator != IntegratorType::ImplicitEuler)
-    throw std::invalid_argument("physics.integrator: a rod (type: rod) bends and twists only under implicit_euler; "
-                                "the scene asks for " + integratorName(scene.physics.integrator));
+  try
+  {
+    requireRodIntegrator(model, scene.physics.integrator);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    throw std::invalid_argument(std::string("physics.integrator: ") + e.what());
+  }
   state.twist.setZero(static_cast<Eigen::Index>(model.rods.size()));
   StepSettings step = scene.physics.step;
   if (scene.physics.auto_dt)

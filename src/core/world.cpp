@@ -166,9 +166,7 @@ std::string World::treatDiverged(std::size_t body)
 
 void World::setIntegrator(IntegratorType type)
 {
-  if (!model_.rods.empty() && type != IntegratorType::ImplicitEuler)
-    throw std::invalid_argument("a rod (type: rod) bends and twists only under implicit_euler, not " +
-                                integratorName(type));
+  requireRodIntegrator(model_, type);
   integrators_.setAll(type);
 }
 

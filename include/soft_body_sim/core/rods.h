@@ -17,6 +17,7 @@
 
 #include <vector>
 
+#include "soft_body_sim/core/integrator.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
@@ -51,6 +52,10 @@ void appendRodVertices(const Rod& rod, std::vector<RodVertex>& vertices);
 
 /// The two edges [m] of vertex `vertex` of `rod` at positions x (see RodVertex).
 void vertexEdges(const Rod& rod, const RodVertex& vertex, const NodeArray& x, Vec3& e0, Vec3& e1);
+
+/// Throws std::invalid_argument if `model` has a rod and `integrator` is not implicit_euler, the only
+/// integrator that bends and twists rods (the others would run it as a chain of springs).
+void requireRodIntegrator(const Model& model, IntegratorType integrator);
 
 /// The index in model.rods of the rod whose held end is node `node`, with that end (0 first, 1 last) in
 /// `end`; -1 if no rod holds an end there.
