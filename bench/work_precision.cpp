@@ -6,10 +6,10 @@
 //                       bending_kLST (one row per configuration and error kind; error inf = diverged, cost
 //                       nan then; bending_kLST: Bullet's bending links' stiffness, empty where none)
 //   best_cost.csv       the cheapest configuration per engine at each error level
-// --only NAME makes and runs only the problems whose name contains NAME (e.g. rod_cantilever).
 //   ratios.csv          the hanging chain at 1 mm: this package's best against Bullet's best
 //   demo.csv            the demo scene's physics cost
 //   machine.txt         where it ran
+// --only NAME makes and runs only the problems whose name contains NAME (e.g. rod_cantilever).
 // and prints a short table. Cost = CPU seconds per simulated second, the median of 3 timed runs after
 // an untimed warm-up run (which also measures the errors); 1 timed run when a run takes over 0.5 s.
 #include <algorithm>
@@ -241,7 +241,7 @@ void measureDemo(const std::string& path, const std::string& out_dir)
 
 int run(int argc, char** argv)
 {
-  std::string out_dir, only, demo;
+  std::string out_dir, demo;
   ProblemOptions options;
   bool use_bullet = true;
   for (int i = 1; i < argc; ++i)
@@ -252,7 +252,7 @@ int run(int argc, char** argv)
     else if (arg == "--no-bullet")
       use_bullet = false;
     else if (arg == "--only" && i + 1 < argc)
-      only = options.only = argv[++i];
+      options.only = argv[++i];
     else if (arg == "--demo" && i + 1 < argc)
       demo = argv[++i];
     else if (!arg.empty() && arg[0] != '-' && out_dir.empty())
@@ -282,8 +282,6 @@ int run(int argc, char** argv)
   std::vector<Row> rows;
   for (const Problem& problem : problems)
   {
-    if (!only.empty() && problem.name.find(only) == std::string::npos)
-      continue;
     std::fprintf(stderr, "[work_precision] %s, %d nodes: %zu configurations%s\n", problem.name.c_str(), problem.n_nodes,
                  problem.sweep.size(),
                  problem.bullet && use_bullet && bulletAvailable()
@@ -322,8 +320,6 @@ int run(int argc, char** argv)
   std::printf("\nBest cost [CPU s per simulated s] reaching each error level (- = none does)\n");
   for (const Problem& problem : problems)
   {
-    if (!only.empty() && problem.name.find(only) == std::string::npos)
-      continue;
     // The engines that ran it (a rod runs under implicit_euler only).
     std::vector<std::string> engines;
     for (const std::string& engine : integratorNames())
@@ -364,7 +360,7 @@ int run(int argc, char** argv)
     std::printf("\nHanging chain, max node error <= 1 mm: this package's best against Bullet's best\n");
   for (const Problem& problem : problems)
   {
-    if (problem.name.rfind("hanging_chain", 0) != 0 || (!only.empty() && problem.name.find(only) == std::string::npos))
+    if (problem.name.rfind("hanging_chain", 0) != 0)
       continue;
     const Row* ours = nullptr;
     std::string ours_engine;
