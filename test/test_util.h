@@ -1,13 +1,14 @@
 // Helpers shared by the core tests: small scenes built from plain structs, and Eigen comparisons.
 #pragma once
 
-#include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "soft_body_sim/core/rods.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/core/stability.h"
 
@@ -34,13 +35,21 @@ template <typename A, typename B>
 inline std::vector<IntegratorType> stableIntegrators(const SceneDef& scene)
 {
   std::vector<IntegratorType> stable;
+  SceneDef as_built = scene;
+  as_built.physics.integrator = IntegratorType::ImplicitEuler;  // the one integrator every scene loads under
+  const Model model = buildWorld(as_built).model();
   for (const std::string& name : integratorNames())
   {
     SceneDef with = scene;
     integratorFromName(name, with.physics.integrator);
-    if (!scene.bodies.empty() && with.physics.integrator != IntegratorType::ImplicitEuler &&
-        std::any_of(scene.bodies.begin(), scene.bodies.end(), [](const BodyDef& body) { return body.rod.has_value(); }))
+    try
+    {
+      requireRodIntegrator(model, with.physics.integrator);
+    }
+    catch (const std::invalid_argument&)
+    {
       continue;
+    }
     const World world = buildWorld(with);
     if (stabilityWarnings(world.model(), world.state(), with.physics.integrator, world.settings()).empty())
       stable.push_back(with.physics.integrator);
