@@ -84,7 +84,7 @@ void AnchorSet::land(Model& model, State& state)
     if (const int r = turns_[k] ? heldRodEnd(model, model.anchors[k].node, end) : -1; r >= 0)
     {
       Rod& rod = model.rods[static_cast<std::size_t>(r)];
-      rod.end_frame[end] = turns_[k]->normalized() * rod.rest_frame;
+      rod.end_frame[end] = *turns_[k] * rod.rest_frame;
     }
     turns_[k].reset();
   }

@@ -96,10 +96,15 @@ void appendRodVertices(const Rod& rod, std::vector<RodVertex>& vertices)
   const double inner = rod.bending_stiffness / (2.0 * rod.segment_length);
   for (int i = rod.first + 1; i < rod.last(); ++i)
     vertices.push_back({ i - 1, i, i + 1, inner });
-  if (rod.held[0])
-    vertices.push_back({ -1, rod.first, rod.first + 1, 2.0 * inner });
-  if (rod.held[1])
-    vertices.push_back({ rod.last() - 1, rod.last(), -1, 2.0 * inner });
+  for (int end = 0; end < 2; ++end)
+    if (rod.held[end])
+      vertices.push_back(heldVertex(rod, end));
+}
+
+RodVertex heldVertex(const Rod& rod, int end)
+{
+  const double weight = rod.bending_stiffness / rod.segment_length;  // E I / (2 D), D = l / 2
+  return end == 0 ? RodVertex{ -1, rod.first, rod.first + 1, weight } : RodVertex{ rod.last() - 1, rod.last(), -1, weight };
 }
 
 void vertexEdges(const Rod& rod, const RodVertex& vertex, const NodeArray& x, Vec3& e0, Vec3& e1)
@@ -225,9 +230,7 @@ Vec3 heldEndTorque(const Rod& rod, const NodeArray& x, double twist, int end)
   if (!rod.held[end])
     return Vec3::Zero();
   const Vec3 axis = heldAxis(rod, end);
-  const int at = end == 0 ? rod.first : rod.last();
-  const RodVertex vertex = end == 0 ? RodVertex{ -1, at, at + 1, rod.bending_stiffness / rod.segment_length }
-                                    : RodVertex{ at - 1, at, -1, rod.bending_stiffness / rod.segment_length };
+  const RodVertex vertex = heldVertex(rod, end);
   Vec3 e0, e1;
   vertexEdges(rod, vertex, x, e0, e1);
   const CurvatureBinormal bend = curvatureBinormal(e0, e1, rod.segment_length * rod.segment_length);

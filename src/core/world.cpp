@@ -27,9 +27,12 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
   const Eigen::Index n = model_.nodeCount();
   if (model_.contact_radius.size() == 0)
     model_.contact_radius.setZero(n);  // a model made without radii: points
+  const Eigen::Index rods = static_cast<Eigen::Index>(model_.rods.size());
+  if (state_.twist.size() == 0)
+    state_.twist.setZero(rods);  // a state made without twists: its rods untwisted
   if (model_.inverse_mass.size() != n || model_.contact_radius.size() != n || state_.position.cols() != n ||
-      state_.velocity.cols() != n)
-    throw std::invalid_argument("World: mass, inverse mass, contact radius, position and velocity sizes differ");
+      state_.velocity.cols() != n || state_.twist.size() != rods)
+    throw std::invalid_argument("World: mass, inverse mass, contact radius, position, velocity and twist sizes differ");
   if (!(settings_.dt > 0.0) || settings_.substeps < 1 || settings_.iterations < 1)
     throw std::invalid_argument("World: dt must be > 0, substeps and iterations >= 1");
   for (const Anchor& anchor : model_.anchors)
@@ -302,7 +305,7 @@ NodeArray World::pulls() const
   NodeArray pull;
   internalPulls(model_, state_.position, internalForces(), pull);
   for (std::size_t r = 0; r < model_.rods.size(); ++r)
-    accumulateRodForces(model_.rods[r], state_.position, rodTwistOf(r), pull);
+    accumulateRodForces(model_.rods[r], state_.position, state_.twist[static_cast<Eigen::Index>(r)], pull);
   return pull;
 }
 
@@ -319,7 +322,7 @@ std::vector<Wrench> World::anchorWrenches() const
     int end = 0;
     if (const int r = heldRodEnd(model_, anchor.node, end); r >= 0)
       wrenches.back().torque += heldEndTorque(model_.rods[static_cast<std::size_t>(r)], state_.position,
-                                              rodTwistOf(static_cast<std::size_t>(r)), end);
+                                              state_.twist[r], end);
   }
   return wrenches;
 }

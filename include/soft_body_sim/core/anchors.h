@@ -33,7 +33,7 @@ public:
   void setGoal(std::size_t k, const Vec3& position, const Eigen::Quaterniond& orientation)
   {
     goals_.at(k) = position;
-    turns_.at(k) = orientation;
+    turns_.at(k) = orientation.normalized();
   }
   /// Anchor k follows path(t) every step (an empty path stops it); a goal set for a step overrides it.
   void followPath(std::size_t k, AnchorPath path) { paths_.at(k) = std::move(path); }

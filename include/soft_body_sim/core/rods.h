@@ -50,6 +50,9 @@ struct RodVertex
 /// Appends the rod's bending vertices: its inner nodes, then its held ends.
 void appendRodVertices(const Rod& rod, std::vector<RodVertex>& vertices);
 
+/// The bending vertex at held end `end` (0: first node, 1: last), with its ghost edge.
+RodVertex heldVertex(const Rod& rod, int end);
+
 /// The two edges [m] of vertex `vertex` of `rod` at positions x (see RodVertex).
 void vertexEdges(const Rod& rod, const RodVertex& vertex, const NodeArray& x, Vec3& e0, Vec3& e1);
 

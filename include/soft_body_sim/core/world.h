@@ -200,12 +200,6 @@ private:
   std::string treatDiverged(std::size_t body);
   /// Per node, the internal forces on it (internalPulls).
   NodeArray pulls() const;
-  /// Rod r's total twist [rad] (State::twist; 0 before its first step).
-  double rodTwistOf(std::size_t r) const
-  {
-    const Eigen::Index k = static_cast<Eigen::Index>(r);
-    return k < state_.twist.size() ? state_.twist[k] : 0.0;
-  }
   /// The model's parameters or pinning changed: the integrators drop their caches.
   void modelChanged() { integrators_.modelChanged(); }
 

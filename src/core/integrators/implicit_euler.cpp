@@ -62,7 +62,6 @@ public:
     start_v_ = state.velocity;
     if (state.twist.size() != static_cast<Eigen::Index>(model.rods.size()))
       state.twist.setZero(static_cast<Eigen::Index>(model.rods.size()));
-    twist_ = &state.twist;
     if (!analyzed_)
       analyze(model);
     for (int k = 0; k < iterations; ++k)
@@ -82,7 +81,7 @@ public:
         else
           linear_x_.col(i) += h * v_k.col(i);
       }
-      assemble(model, k == 0 ? start_x_ : linear_x_, v_k, h);
+      assemble(model, k == 0 ? start_x_ : linear_x_, v_k, state.twist, h);
       solve(model);
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
@@ -123,8 +122,9 @@ private:
     double scale;  ///< (h^2 + h beta) 2 w [N m^3 s^2]
   };
 
-  /// Fills the blocks of A = M - h D - h^2 K and rhs_ (see the class comment) at (x, v).
-  void assemble(const Model& model, const NodeArray& x, const NodeArray& v, double h)
+  /// Fills the blocks of A = M - h D - h^2 K and rhs_ (see the class comment) at (x, v), the rods' twists
+  /// counted on from `twist` (State::twist).
+  void assemble(const Model& model, const NodeArray& x, const NodeArray& v, const Eigen::VectorXd& twist, double h)
   {
     const int n = model.nodeCount();
     rhs_.resize(3, n);
@@ -214,14 +214,14 @@ private:
     for (std::size_t k = 0; k < model.cells.size(); ++k)
       addCell(model, model.cells[k], x, h, cells_[k]);
     if (!model.rods.empty())
-      addRods(model, x, v, h);
+      addRods(model, x, v, twist, h);
   }
 
   /// The rods' bending blocks (on the diagonal here; off it in multiply and solveDirectly) and their
   /// bending, damping and twist forces in rhs_: per vertex, with q = sum_l J_l offset_l and
   /// r = sum_l J_l v_l, rhs_k -= 2 w h J_k^T (kb + q + beta r); per rod that twists,
   /// rhs_i -= h (G J twist / L) d(twist)/dx_i.
-  void addRods(const Model& model, const NodeArray& x, const NodeArray& v, double h)
+  void addRods(const Model& model, const NodeArray& x, const NodeArray& v, const Eigen::VectorXd& twist, double h)
   {
     rod_blocks_.resize(rod_vertices_.size());
     for (std::size_t k = 0; k < rod_vertices_.size(); ++k)
@@ -266,9 +266,9 @@ private:
       const Rod& rod = model.rods[r];
       if (!rod.twists())
         continue;
-      const double twist = rodTwist(rod, x, (*twist_)[static_cast<Eigen::Index>(r)]);
       rodTwistGradient(rod, x, twist_gradient_);
-      const double moment = rod.twisting_stiffness * twist / rod.restLength();
+      const double moment =
+          rod.twisting_stiffness * rodTwist(rod, x, twist[static_cast<Eigen::Index>(r)]) / rod.restLength();
       for (int j = 0; j < rod.count; ++j)
         if (model.isFree(rod.first + j))
           rhs_.col(rod.first + j) -= h * moment * twist_gradient_.col(j);
@@ -576,7 +576,6 @@ private:
   std::vector<RodBlock> rod_blocks_;     ///< per rod vertex
   std::vector<int> rod_slot_;            ///< per rod vertex, three: each node pair's slot, or -1
   NodeArray twist_gradient_;             ///< d(twist)/dx of one rod (rodTwistGradient)
-  const Eigen::VectorXd* twist_ = nullptr;  ///< the state's twists during a step
 };
 }  // namespace
 
