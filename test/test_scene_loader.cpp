@@ -1394,7 +1394,7 @@ bodies:
     youngs_modulus: 2.0e9
     density: 1000.0
     damping: 0.01
-    clamped: [0]
+    clamped: [0, 2]
     anchors: [{name: tip, node: -1}]
 )",
                                      "cable.yaml");
@@ -1405,7 +1405,12 @@ bodies:
   EXPECT_DOUBLE_EQ(rod.bending_stiffness, 2.0e9 * second_moment);
   EXPECT_DOUBLE_EQ(rod.twisting_stiffness, 2.0e9 / 2.6 * 2.0 * second_moment);  // G defaults to E / 2.6
   EXPECT_DOUBLE_EQ(rod.segment_length, 0.25);
-  EXPECT_TRUE(rod.held[0] && rod.held[1]);  // clamped, and anchored at its last node
+  // Held at its clamped nodes (an inner one too) and at its anchored last node, in order.
+  ASSERT_EQ(rod.stations.size(), 3u);
+  EXPECT_EQ(rod.stations[0].first, 0);
+  EXPECT_EQ(rod.stations[1].first, 2);
+  EXPECT_EQ(rod.stations[2].first, 4);
+  EXPECT_EQ(rod.end_moment, Vec3::Zero());
   EXPECT_DOUBLE_EQ(world.model().springs[0].stiffness, 2.0e9 * M_PI * 0.01 * 0.01 / 0.25);
   EXPECT_DOUBLE_EQ(world.model().mass[0], 0.5 * 1000.0 * M_PI * 0.01 * 0.01 * 0.25);
   EXPECT_DOUBLE_EQ(world.model().contact_radius[2], 0.01);
@@ -1415,8 +1420,8 @@ TEST(SceneLoader, ARodsMistakesAreNamedAtTheirKeys)
 {
   const std::string rod = "{name: c, type: rod, nodes: 5, from: [0, 0, 1], to: [1, 0, 1], radius: 0.01, "
                           "youngs_modulus: 1e9, density: 1000";
-  expectSceneError("bodies:\n  - " + rod + ", clamped: [2]}\n", "bad.yaml:2: bodies[0].clamped",
-                   { "not an end", "grasp" });
+  expectSceneError("bodies:\n  - " + rod + ", clamped: [5]}\n", "bad.yaml:2: bodies[0].clamped[0]", { "out of range" });
+  expectSceneError("bodies:\n  - " + rod + ", end_moment: [0, .nan, 0]}\n", "bad.yaml:2: bodies[0].end_moment[1]", { "finite" });
   expectSceneError("bodies:\n  - " + rod + ", shear_modulus: 0}\n", "bad.yaml:2: bodies[0].shear_modulus", { "> 0" });
   expectSceneError("bodies:\n  - " + rod + ", pinned: [0]}\n", "bad.yaml:2: bodies[0].pinned", {});
   // Only implicit_euler bends and twists a rod: another integrator is refused, not silently a spring chain.
@@ -1429,6 +1434,20 @@ TEST(SceneLoader, ARodsMistakesAreNamedAtTheirKeys)
   {
     EXPECT_NE(std::string(e.what()).find("implicit_euler"), std::string::npos) << e.what();
   }
+  // An end moment acts on a free end: on a held one the holder would take it.
+  try
+  {
+    buildWorld(parseScene("physics: {integrator: implicit_euler}\nbodies:\n  - " + rod +
+                              ", end_moment: [0, 1, 0], clamped: [-1]}\n", "bad.yaml"));
+    ADD_FAILURE() << "built an end moment on a clamped end";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("end_moment"), std::string::npos) << e.what();
+  }
+  const SceneDef loaded =
+      parseScene("physics: {integrator: implicit_euler}\nbodies:\n  - " + rod + ", end_moment: [0, -2, 0]}\n", "ok.yaml");
+  EXPECT_EQ(buildWorld(loaded).model().rods[0].end_moment, Vec3(0.0, -2.0, 0.0));
   World world = buildWorld(parseScene("physics: {integrator: implicit_euler}\nbodies:\n  - " + rod + "}\n", "ok.yaml"));
   EXPECT_THROW(world.setIntegrator(IntegratorType::Rk4), std::invalid_argument);
   EXPECT_EQ(world.integrator(), IntegratorType::ImplicitEuler);

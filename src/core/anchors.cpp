@@ -34,11 +34,10 @@ bool AnchorSet::setVelocities(const Model& model, State& state, double dt)
   for (std::size_t k = 0; k < model.anchors.size(); ++k)
   {
     const int node = model.anchors[k].node;
-    int end = 0;
-    if (const int r = turns_[k] ? heldRodEnd(model, node, end) : -1; r >= 0)
+    if (const StationIndex at = turns_[k] ? findRodStation(model, node) : StationIndex{})
     {
-      const Rod& rod = model.rods[static_cast<std::size_t>(r)];
-      turned_from_[k] = rod.end_frame[end] * rod.rest_frame.conjugate();
+      const RodStation& station = rodStation(model, at);
+      turned_from_[k] = station.frame[0] * station.held[0].conjugate();
       moved = true;
     }
     if (goals_[k])
@@ -62,12 +61,8 @@ void AnchorSet::advance(Model& model, State& state, int substep, int substeps, d
   {
     const int node = model.anchors[k].node;
     state.position.col(node) += h * state.velocity.col(node);
-    int end = 0;
-    if (const int r = turns_[k] ? heldRodEnd(model, node, end) : -1; r >= 0)
-    {
-      Rod& rod = model.rods[static_cast<std::size_t>(r)];
-      rod.end_frame[end] = turned_from_[k].slerp(static_cast<double>(substep) / substeps, *turns_[k]) * rod.rest_frame;
-    }
+    if (const StationIndex at = turns_[k] ? findRodStation(model, node) : StationIndex{})
+      rodStation(model, at).turn(turned_from_[k].slerp(static_cast<double>(substep) / substeps, *turns_[k]));
   }
 }
 
@@ -80,12 +75,8 @@ void AnchorSet::land(Model& model, State& state)
       state.position.col(model.anchors[k].node) = *goals_[k];
       goals_[k].reset();
     }
-    int end = 0;
-    if (const int r = turns_[k] ? heldRodEnd(model, model.anchors[k].node, end) : -1; r >= 0)
-    {
-      Rod& rod = model.rods[static_cast<std::size_t>(r)];
-      rod.end_frame[end] = *turns_[k] * rod.rest_frame;
-    }
+    if (const StationIndex at = turns_[k] ? findRodStation(model, model.anchors[k].node) : StationIndex{})
+      rodStation(model, at).turn(*turns_[k]);
     turns_[k].reset();
   }
 }

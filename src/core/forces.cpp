@@ -101,11 +101,8 @@ double potentialEnergy(const Model& model, const State& state)
   }
   for (const PressureCell& cell : model.cells)
     energy += cellGas(cell, cellArea(cell, state.position)).energy;
-  for (std::size_t r = 0; r < model.rods.size(); ++r)
-  {
-    const Eigen::Index k = static_cast<Eigen::Index>(r);
-    energy += rodEnergy(model.rods[r], state.position, k < state.twist.size() ? state.twist[k] : 0.0);
-  }
+  for (const Rod& rod : model.rods)
+    energy += rodEnergy(rod, state.position, state.twist);
   for (int i = 0; i < model.nodeCount(); ++i)
     if (model.isFree(i))
       energy -= model.mass[i] * model.gravity.dot(state.position.col(i));

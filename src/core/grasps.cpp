@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "soft_body_sim/core/rods.h"
+
 namespace soft_body_sim
 {
 namespace
@@ -19,7 +21,7 @@ std::string GraspSlip::describe() const
   return "grasp '" + grasp + "' on body '" + body + text;
 }
 
-std::size_t GraspSet::grasp(Model& model, const State& state, const std::string& name, const std::string& body,
+std::size_t GraspSet::grasp(Model& model, State& state, const std::string& name, const std::string& body,
                             const RigidPose& pose, double radius, double max_force)
 {
   if (find(name) < grasps_.size())
@@ -33,7 +35,7 @@ std::size_t GraspSet::grasp(Model& model, const State& state, const std::string&
     ++b;
   if (b == model.bodies.size())
     throw std::invalid_argument("there is no body '" + body + "'");
-  GraspedNodes g{ name, b, {}, {}, unit(pose), max_force };
+  GraspedNodes g{ name, b, {}, {}, unit(pose), {}, max_force };
   const Eigen::Quaterniond to_frame = g.pose.orientation.conjugate();
   const BodyRange& range = model.bodies[b];
   for (int i = range.first; i < range.first + range.count; ++i)
@@ -47,17 +49,34 @@ std::size_t GraspSet::grasp(Model& model, const State& state, const std::string&
   // Pinned = inverse mass 0: from now on only the grasp moves them (Ten Minute Physics' grab).
   for (const int node : g.nodes)
     model.inverse_mass[node] = 0.0;
+  for (Rod& rod : model.rods)
+    if (rod.first == range.first)
+      for (std::size_t k = 0; k < g.nodes.size();)
+      {
+        // g.nodes ascend: each run of consecutive nodes is one station.
+        std::size_t end = k + 1;
+        while (end < g.nodes.size() && g.nodes[end] == g.nodes[end - 1] + 1)
+          ++end;
+        holdRod(rod, state.position, state.twist, g.nodes[k], g.nodes[end - 1], g.pose.orientation);
+        g.rod_stations.push_back(g.nodes[k]);
+        k = end;
+      }
   grasps_.push_back(std::move(g));
   goals_.emplace_back();
   paths_.emplace_back();
   return grasps_.back().nodes.size();
 }
 
-bool GraspSet::release(Model& model, const std::string& name, bool frozen)
+bool GraspSet::release(Model& model, State& state, const std::string& name, bool frozen)
 {
   const std::size_t k = find(name);
   if (k == grasps_.size())
     return false;
+  for (const int node : grasps_[k].rod_stations)
+  {
+    const StationIndex at = findRodStation(model, node);
+    releaseRod(model.rods[static_cast<std::size_t>(at.rod)], state.position, state.twist, at.station);
+  }
   for (const int node : grasps_[k].nodes)
     model.inverse_mass[node] = frozen ? 0.0 : 1.0 / model.mass[node];
   const auto at = static_cast<std::ptrdiff_t>(k);
@@ -110,13 +129,15 @@ RigidPose GraspSet::at(std::size_t k, double s) const
                     from.orientation.slerp(s, goals_[k]->orientation) };
 }
 
-void GraspSet::advance(State& state, int substep, int substeps, double h) const
+void GraspSet::advance(Model& model, State& state, int substep, int substeps, double h) const
 {
   const double s = static_cast<double>(substep) / substeps;
   for (std::size_t k = 0; k < grasps_.size(); ++k)
   {
     const GraspedNodes& g = grasps_[k];
     const RigidPose pose = at(k, s);
+    for (const int node : g.rod_stations)
+      rodStation(model, findRodStation(model, node)).turn(pose.orientation);
     for (std::size_t n = 0; n < g.nodes.size(); ++n)
     {
       const Vec3 x = pose.position + pose.orientation * g.offsets[n];
@@ -136,11 +157,19 @@ void GraspSet::land()
     }
 }
 
-std::vector<Wrench> GraspSet::wrenches(const Model& model, const NodeArray& x, const NodeArray& pull) const
+std::vector<Wrench> GraspSet::wrenches(const Model& model, const State& state, const NodeArray& pull) const
 {
   std::vector<Wrench> wrenches;
   for (const GraspedNodes& g : grasps_)
-    wrenches.push_back(holdingWrench(model, x, pull, g.nodes, g.pose.position));
+  {
+    wrenches.push_back(holdingWrench(model, state.position, pull, g.nodes, g.pose.position));
+    for (const int node : g.rod_stations)
+    {
+      const StationIndex at = findRodStation(model, node);
+      wrenches.back().torque +=
+          stationTorque(model.rods[static_cast<std::size_t>(at.rod)], at.station, state.position, state.twist);
+    }
+  }
   return wrenches;
 }
 

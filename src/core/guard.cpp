@@ -68,6 +68,10 @@ std::vector<DivergenceGuard::Catch> DivergenceGuard::restoreDiverged(const Model
         state.position.col(i) = last_good_.position.col(i);
         state.velocity.col(i) = last_good_.velocity.col(i);
       }
+    // A rod's twists (State::twist, one entry per node) go back with its nodes: a twist counted on from a
+    // non-finite one would stay non-finite.
+    if (state.twist.size() > 0)
+      state.twist.segment(body.first, body.count) = last_good_.twist.segment(body.first, body.count);
     caught.push_back({ b, std::move(reason) });
   }
   return caught;
@@ -88,6 +92,7 @@ void DivergenceGuard::checkpoint(const State& state, std::int64_t step, bool cau
   // Same sizes: a plain copy, no allocation.
   std::copy_n(state.position.data(), state.position.size(), last_good_.position.data());
   std::copy_n(state.velocity.data(), state.velocity.size(), last_good_.velocity.data());
+  std::copy_n(state.twist.data(), state.twist.size(), last_good_.twist.data());
 }
 
 std::string DivergenceGuard::freeze(Model& model, State& state, std::size_t body)

@@ -174,11 +174,17 @@ World buildWorld(const SceneDef& scene)
     {
       Rod rod = *body.rod;
       rod.first += first;
-      // An anchor on an end holds its orientation as well as its position: a gripper turns the rod's end.
+      for (RodStation& station : rod.stations)
+      {
+        station.first += first;
+        station.last += first;
+      }
+      // An anchor holds its orientation as well as its position: a gripper turns and bends the rod there.
       for (const AnchorDef& anchor : body.anchors)
-        for (int end = 0; end < 2; ++end)
-          if (globalIndex(body, first, anchor.node) == (end == 0 ? rod.first : rod.last()))
-            rod.held[end] = true;
+        clampRod(rod, globalIndex(body, first, anchor.node));
+      if (!rod.end_moment.isZero(0.0) && !rod.stations.empty() && rod.stations.back().last == rod.last())
+        throw std::invalid_argument("body '" + body.name + "': end_moment acts on a free last node, but its "
+                                    "last node is clamped or anchored (the holder takes any moment there)");
       model.rods.push_back(rod);
     }
     for (const auto& [a, b] : body.contact_segments)
@@ -204,7 +210,8 @@ World buildWorld(const SceneDef& scene)
   {
     throw std::invalid_argument(std::string("physics.integrator: ") + e.what());
   }
-  state.twist.setZero(static_cast<Eigen::Index>(model.rods.size()));
+  if (!model.rods.empty())
+    state.twist.setZero(model.nodeCount());
   StepSettings step = scene.physics.step;
   if (scene.physics.auto_dt)
   {

@@ -27,11 +27,14 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
   const Eigen::Index n = model_.nodeCount();
   if (model_.contact_radius.size() == 0)
     model_.contact_radius.setZero(n);  // a model made without radii: points
-  const Eigen::Index rods = static_cast<Eigen::Index>(model_.rods.size());
-  if (state_.twist.size() == 0)
-    state_.twist.setZero(rods);  // a state made without twists: its rods untwisted
+  const Eigen::Index twists = model_.rods.empty() ? 0 : n;
+  if (state_.twist.size() == 0 && twists > 0)
+  {
+    state_.twist.setZero(twists);  // a state made without twists: its rods untwisted
+    guard_.checkpoint(state_, 0, true);
+  }
   if (model_.inverse_mass.size() != n || model_.contact_radius.size() != n || state_.position.cols() != n ||
-      state_.velocity.cols() != n || state_.twist.size() != rods)
+      state_.velocity.cols() != n || state_.twist.size() != twists)
     throw std::invalid_argument("World: mass, inverse mass, contact radius, position, velocity and twist sizes differ");
   if (!(settings_.dt > 0.0) || settings_.substeps < 1 || settings_.iterations < 1)
     throw std::invalid_argument("World: dt must be > 0, substeps and iterations >= 1");
@@ -76,7 +79,7 @@ bool World::driveKinematicNodes(double dt)
 void World::moveHeldNodes(int substep, double h)
 {
   anchors_.advance(model_, state_, substep, settings_.substeps, h);
-  grasps_.advance(state_, substep, settings_.substeps, h);
+  grasps_.advance(model_, state_, substep, settings_.substeps, h);
   integrators_.invalidate();
 }
 
@@ -285,6 +288,8 @@ bool World::detach(int anchor)
     return false;
   const auto k = static_cast<std::size_t>(anchor);
   const int node = model_.anchors[k].node;
+  if (const StationIndex at = findRodStation(model_, node))
+    releaseRod(model_.rods[static_cast<std::size_t>(at.rod)], state_.position, state_.twist, at.station);
   // A node of a frozen body stays pinned: the guard froze it there.
   model_.inverse_mass[node] = guard_.isFrozen(model_.bodyOf(node)) ? 0.0 : 1.0 / model_.mass[node];
   model_.anchors.erase(model_.anchors.begin() + anchor);
@@ -304,8 +309,8 @@ NodeArray World::pulls() const
 {
   NodeArray pull;
   internalPulls(model_, state_.position, internalForces(), pull);
-  for (std::size_t r = 0; r < model_.rods.size(); ++r)
-    accumulateRodForces(model_.rods[r], state_.position, state_.twist[static_cast<Eigen::Index>(r)], pull);
+  for (const Rod& rod : model_.rods)
+    accumulateRodForces(rod, state_.position, state_.twist, pull);
   return pull;
 }
 
@@ -318,11 +323,9 @@ std::vector<Wrench> World::anchorWrenches() const
   for (const Anchor& anchor : model_.anchors)
   {
     wrenches.push_back(holdingWrench(model_, state_.position, pull, { anchor.node }, state_.position.col(anchor.node)));
-    // A rod's held end takes its bending and twisting moment too.
-    int end = 0;
-    if (const int r = heldRodEnd(model_, anchor.node, end); r >= 0)
-      wrenches.back().torque += heldEndTorque(model_.rods[static_cast<std::size_t>(r)], state_.position,
-                                              state_.twist[r], end);
+    // A rod takes its bending and twisting moment there too.
+    if (const StationIndex at = findRodStation(model_, anchor.node))
+      wrenches.back().torque += stationTorque(model_.rods[static_cast<std::size_t>(at.rod)], at.station, state_.position, state_.twist);
   }
   return wrenches;
 }
@@ -331,7 +334,7 @@ std::vector<Wrench> World::graspWrenches() const
 {
   if (grasps_.empty())
     return {};
-  return grasps_.wrenches(model_, state_.position, pulls());
+  return grasps_.wrenches(model_, state_, pulls());
 }
 
 std::size_t World::grasp(const std::string& frame, const std::string& body, const RigidPose& pose, double radius,
@@ -347,7 +350,7 @@ bool World::release(const std::string& frame)
   for (const GraspedNodes& g : grasps_.grasps())
     if (g.name == frame)
     {
-      grasps_.release(model_, frame, guard_.isFrozen(g.body));
+      grasps_.release(model_, state_, frame, guard_.isFrozen(g.body));
       modelChanged();
       return true;
     }

@@ -155,7 +155,7 @@ void addRodMarkers(const World& world, const std::string& frame_id, const ros::T
                                               2.0 * model.contact_radius[rod.first], bodyColor(b));
     visualization_msgs::Marker axes =
         marker(frame_id, stamp, name + "/frames", 0, visualization_msgs::Marker::LINE_LIST, 0.5 * kLineWidth, bodyColor(b));
-    rodFrames(rod, x, world.state().twist[static_cast<Eigen::Index>(r)], frames);
+    rodFrames(rod, x, world.state().twist, frames);
     const double length = 0.8 * rod.segment_length;
     for (int j = 0; j < rod.count; ++j)
     {

@@ -200,12 +200,11 @@ void SimNode::warnIfRodEndJumps(const ScheduledInput& input) const
   // one linearised sub-step can fold its last segment back, which unfolds only slowly.
   const Model& model = world_->model();
   const Anchor& anchor = model.anchors[static_cast<std::size_t>(input.anchor)];
-  int end = 0;
-  const int r = heldRodEnd(model, anchor.node, end);
-  if (r < 0)
+  const StationIndex at = findRodStation(model, anchor.node);
+  if (!at)
     return;
   const int substeps = world_->settings().substeps;
-  const double segment = model.rods[static_cast<std::size_t>(r)].segment_length;
+  const double segment = model.rods[static_cast<std::size_t>(at.rod)].segment_length;
   const double jump = (input.position - world_->state().position.col(anchor.node)).norm();
   if (jump <= segment * substeps)
     return;

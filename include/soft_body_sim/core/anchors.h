@@ -28,8 +28,9 @@ public:
   /// Anchor k moves to `position` [m] during the next step; the latest call before a step wins.
   void setGoal(std::size_t k, const Vec3& position) { goals_.at(k) = position; }
   /// Anchor k also turns to `orientation` (unit; identity = as the scene built it) during the next step, if
-  /// it holds a rod's end (Rod::held): the end's frame becomes orientation * Rod::rest_frame, turning at
-  /// constant angular velocity (slerp) over the step's sub-steps. Other anchors hold no orientation.
+  /// it holds a rod station (a scene's anchor on a rod: RodStation): the station's frames turn with it
+  /// (RodStation::turn), at constant angular velocity (slerp) over the step's sub-steps. Other anchors hold
+  /// no orientation.
   void setGoal(std::size_t k, const Vec3& position, const Eigen::Quaterniond& orientation)
   {
     goals_.at(k) = position;

@@ -27,6 +27,9 @@ struct GraspedNodes
   std::vector<int> nodes;    ///< global node indices, pinned while held
   std::vector<Vec3> offsets; ///< each node's position in the frame [m]
   RigidPose pose;            ///< the frame's pose now
+  /// On a rod: the first node of each station it holds there (a run of consecutive nodes; RodStation), which
+  /// turn with its frame.
+  std::vector<int> rod_stations;
   double max_force = std::numeric_limits<double>::infinity();  ///< [N]: above it the grasp slips
 };
 
@@ -46,14 +49,15 @@ class GraspSet
 {
 public:
   /// Grasps every free node of body `body` within `radius` [m] of `pose`'s origin: pins them (inverse mass
-  /// 0) and keeps their offsets in the frame. Returns how many it holds. Throws std::invalid_argument if a
+  /// 0) and keeps their offsets in the frame. On a rod, each run of consecutive nodes it holds becomes a
+  /// station (holdRod) that holds the rod's orientation there too. Returns how many nodes it holds. Throws std::invalid_argument if a
   /// grasp `name` exists, the body is unknown, radius is not finite and > 0, max_force is not > 0 (infinity:
   /// no limit), or no free node of the body is in reach.
-  std::size_t grasp(Model& model, const State& state, const std::string& name, const std::string& body,
+  std::size_t grasp(Model& model, State& state, const std::string& name, const std::string& body,
                     const RigidPose& pose, double radius, double max_force);
   /// Lets grasp `name` go: its nodes are free again (unless `frozen`: a body the guard froze stays pinned)
-  /// and keep their velocities. False if there is none of that name.
-  bool release(Model& model, const std::string& name, bool frozen);
+  /// and keep their velocities; its rod stations go (releaseRod). False if there is none of that name.
+  bool release(Model& model, State& state, const std::string& name, bool frozen);
   /// Grasp `name`'s frame moves to `pose` during the next step; the latest call before a step wins. False if
   /// there is none of that name.
   bool setGoal(const std::string& name, const RigidPose& pose);
@@ -69,15 +73,15 @@ public:
 
   /// Stage, per sub-step `substep` (1 to `substeps`) of h [s]: each grasp's frame is at fraction
   /// substep / substeps of its way to its goal (position linear, orientation by slerp: constant linear and
-  /// angular velocity), its nodes at their offsets in it, with the velocity that got them there. Without a
-  /// goal the frame holds still.
-  void advance(State& state, int substep, int substeps, double h) const;
+  /// angular velocity), its nodes at their offsets in it, with the velocity that got them there, its rod
+  /// stations turned with it. Without a goal the frame holds still.
+  void advance(Model& model, State& state, int substep, int substeps, double h) const;
   /// Stage, at the step's end: the frames are at their goals, and the goals are used up.
   void land();
 
-  /// Per grasp, the wrench its body exerts on it (holdingWrench), torque about its frame's origin; `pull`
-  /// is internalPulls'.
-  std::vector<Wrench> wrenches(const Model& model, const NodeArray& x, const NodeArray& pull) const;
+  /// Per grasp, the wrench its body exerts on it (holdingWrench), torque about its frame's origin, with a
+  /// rod's moments at its stations (stationTorque); `pull` is internalPulls' (with the rods' forces).
+  std::vector<Wrench> wrenches(const Model& model, const State& state, const NodeArray& pull) const;
   /// True if some grasp has a force limit (its wrench is then needed every step).
   bool limited() const;
 

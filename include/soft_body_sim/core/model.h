@@ -54,10 +54,33 @@ struct PressureCell
   double pressure = 0.0;        ///< p0 [N/m] (2D pressure: force per length of outline), > 0
 };
 
+/// Where a rod is held in position and orientation (rods.h): its nodes first .. last, pinned, and the
+/// material frame they hold. A clamped or anchored end is a station of one node; a grasp makes one of
+/// the nodes it holds. A station of one node holds the rod's direction there (its frame's x axis) on both
+/// sides; a longer one holds it through its nodes' positions. The rod twists between consecutive stations.
+struct RodStation
+{
+  int first = 0;  ///< global index of its first node
+  int last = 0;   ///< global index of its last node (first for a station of one node)
+  /// The rod's material frame now where it enters the station ([0], toward the rod's first node) and where
+  /// it leaves it ([1]): the frames of its first and last segments (equal for a station of one node).
+  Eigen::Quaterniond frame[2] = { Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity() };
+  /// The same frames in the frame of whatever holds the station (a grasp's frame, an anchor's turn): when
+  /// it turns by q, frame[c] = q * held[c].
+  Eigen::Quaterniond held[2] = { Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity() };
+
+  /// The holder is at orientation q now (unit).
+  void turn(const Eigen::Quaterniond& q)
+  {
+    frame[0] = q * held[0];
+    frame[1] = q * held[1];
+  }
+};
+
 /// A rod's bending and twisting (a `type: rod` body; rods.h): a discrete elastic rod (Bergou et al. 2008),
 /// isotropic (circular cross-section), straight and untwisted at rest, its nodes first .. first + count - 1
-/// in order. Its stretching is springs of Model::springs. An end is *held* when its node is clamped or
-/// anchored: its position and its orientation belong to the caller, the orientation as `end_frame`.
+/// in order. Its stretching is springs of Model::springs. Its stations (clamped or anchored ends, grasps)
+/// hold positions and orientations; they belong to the caller.
 /// Material frames: x along the rod (from its first node to its last), y and z across it.
 struct Rod
 {
@@ -68,14 +91,14 @@ struct Rod
   double twisting_stiffness = 0.0;   ///< G J [N m^2], > 0
   double damping = 0.0;              ///< beta [s]: stiffness-proportional damping of its bending (Rayleigh)
   Eigen::Quaterniond rest_frame = Eigen::Quaterniond::Identity();  ///< every segment's frame at rest
-  bool held[2] = { false, false };   ///< its first / last node holds position and orientation
-  /// The frames of its held ends now (rest_frame until an anchor turns them); unused where not held.
-  Eigen::Quaterniond end_frame[2] = { Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity() };
+  /// Its stations in order along it, apart from each other (a grasp never holds a pinned node).
+  std::vector<RodStation> stations;
+  /// [N m] a constant moment on its last node about fixed world axes (its last end free), applied as the
+  /// couple across its last segment: its part along that segment is not (a free end holds no twist).
+  Vec3 end_moment = Vec3::Zero();
 
   int last() const { return first + count - 1; }
   double restLength() const { return segment_length * (count - 1); }
-  /// True when both ends are held: only then does it store twist (a free end lets it unwind).
-  bool twists() const { return held[0] && held[1]; }
 };
 
 /// A named run of consecutive nodes: the scene's bodies share one node array.
@@ -138,8 +161,9 @@ struct State
 {
   NodeArray position;  ///< [m]
   NodeArray velocity;  ///< [m/s]
-  /// [rad] per rod of Model::rods: its total twist between its held ends (rods.h), counted on through
-  /// whole turns; 0 for a rod that does not twist (Rod::twists).
+  /// [rad] the rods' twists (rods.h): twist[i] is the twist between the rod station whose last node is i
+  /// and the next station along its rod, counted on through whole turns; 0 at every other node. One
+  /// entry per node when the model has rods, none otherwise.
   Eigen::VectorXd twist;
 };
 

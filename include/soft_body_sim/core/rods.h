@@ -5,14 +5,14 @@
 // Why this formulation: a cable's bending and twisting waves are far faster than anything a robot does
 // with it, and its statics (the cantilever, the elastica, the torque of a twisted cable) are what users
 // check it against. DER's state is the nodes' positions only: bending is a function of them, and for an
-// isotropic rod the twist, which relaxes instantly along it, is spread evenly between the two held ends
-// and enters as one number per rod (its total twist). So the rod joins the implicit_euler Newton system
+// isotropic rod the twist, which relaxes instantly along it, is spread evenly between two consecutive
+// stations (the places where it is held: clamped or anchored ends, grasps) and enters as one number per
+// interval between them (its total twist there). So the rod joins the implicit_euler Newton system
 // as three-node blocks beside the springs that stretch it, and the system's fixed point is the discrete
 // rod's exact equilibrium whatever the step. Shear (a Cosserat rod's fifth mode) is left out: for a
 // slender rod its deflection is (r / L)^2 E / G of the bending's (1e-4 for a 5 mm cable 1 m long).
-// Segment orientations are not state but follow from the positions (rodFrames): the frame of the first
-// segment transported along the rod without twisting (parallel transport), turned by its share of the
-// twist.
+// Segment orientations are not state but follow from the positions (rodFrames): a station's frame
+// transported along the rod without twisting (parallel transport), turned by its share of the twist.
 #pragma once
 
 #include <vector>
@@ -35,23 +35,23 @@ struct CurvatureBinormal
 CurvatureBinormal curvatureBinormal(const Vec3& e0, const Vec3& e1, double rest_product);
 
 /// A vertex where a rod bends: the node `at` between the edge x_at - x_before and the edge x_after - x_at.
-/// At a held end the missing edge is the held frame's x axis times l (a ghost edge: the clamp's
-/// direction), and `before` or `after` is -1. Its energy is E = E I |kb|^2 / (2 D) = weight |kb|^2 with D
-/// its share of the rod's length: l inside, l / 2 at a held end (the half segment between the clamp and
-/// the first midpoint). Discretised this way the cantilever's tip deflection converges at second order.
+/// At a station of one node (a held end, a grasp) the rod is held in the direction of the station's frame's
+/// x axis on each side: the missing edge is that axis times l (a ghost edge: the clamp's direction), and
+/// `before` or `after` is -1. Its energy is E = E I |kb|^2 / (2 D) = weight |kb|^2 with D its share of
+/// the rod's length: l inside, l / 2 beside a station (the half segment between the clamp and the first
+/// midpoint). Discretised this way the cantilever's tip deflection converges at second order.
 struct RodVertex
 {
-  int before;     ///< global node, or -1: the held first node's ghost edge
+  int before;     ///< global node, or -1: the ghost edge of station `station`
   int at;         ///< global node
-  int after;      ///< global node, or -1: the held last node's ghost edge
+  int after;      ///< global node, or -1: the ghost edge of station `station`
+  int station;    ///< index into Rod::stations of the ghost edge's station, or -1
   double weight;  ///< E I / (2 D) [N m^3]
 };
 
-/// Appends the rod's bending vertices: its inner nodes, then its held ends.
+/// Appends the rod's bending vertices: its inner nodes apart from its stations of one node, then those
+/// stations' two half vertices (one at an end).
 void appendRodVertices(const Rod& rod, std::vector<RodVertex>& vertices);
-
-/// The bending vertex at held end `end` (0: first node, 1: last), with its ghost edge.
-RodVertex heldVertex(const Rod& rod, int end);
 
 /// The two edges [m] of vertex `vertex` of `rod` at positions x (see RodVertex).
 void vertexEdges(const Rod& rod, const RodVertex& vertex, const NodeArray& x, Vec3& e0, Vec3& e1);
@@ -60,44 +60,96 @@ void vertexEdges(const Rod& rod, const RodVertex& vertex, const NodeArray& x, Ve
 /// integrator that bends and twists rods (the others would run it as a chain of springs).
 void requireRodIntegrator(const Model& model, IntegratorType integrator);
 
-/// The index in model.rods of the rod whose held end is node `node`, with that end (0 first, 1 last) in
-/// `end`; -1 if no rod holds an end there.
-int heldRodEnd(const Model& model, int node, int& end);
+/// A rod station in a model: rod index into Model::rods and station index into its stations (-1: none).
+struct StationIndex
+{
+  int rod = -1;
+  int station = -1;
+  explicit operator bool() const { return rod >= 0; }
+};
 
-/// The unit axis of a held end's frame now (end 0: first node, 1: last), pointing along the rod.
-inline Vec3 heldAxis(const Rod& rod, int end) { return rod.end_frame[end] * Vec3::UnitX(); }
+/// The station of a rod in `model` that holds node `node`, if any.
+StationIndex findRodStation(const Model& model, int node);
+inline RodStation& rodStation(Model& model, StationIndex at)
+{
+  return model.rods[static_cast<std::size_t>(at.rod)].stations[static_cast<std::size_t>(at.station)];
+}
+inline const RodStation& rodStation(const Model& model, StationIndex at)
+{
+  return model.rods[static_cast<std::size_t>(at.rod)].stations[static_cast<std::size_t>(at.station)];
+}
 
-/// The rod's total twist [rad] at x: the angle, about the last held axis, from its first held frame's
-/// y axis carried along the rod by parallel transport (through the first held axis, every segment and the
-/// last held axis) to its last held frame's y axis; > 0 when the last end is turned right-handedly about
-/// the rod. Of the values 2 pi apart, the one nearest `near` (the last step's: a rod counts whole turns).
-/// 0 for a rod that does not twist (Rod::twists).
-double rodTwist(const Rod& rod, const NodeArray& x, double near);
+/// The held axis (unit, along the rod) of station `s` where the rod enters it (side 0) or leaves it (1).
+inline Vec3 stationAxis(const Rod& rod, int s, int side) { return rod.stations[static_cast<std::size_t>(s)].frame[side] * Vec3::UnitX(); }
 
-/// d(twist)/dx [rad/m] of each of the rod's nodes (3 x count; the twist's holonomy, DER section 6): with
-/// kb_k the curvature binormal of unit tangents at each bend of the transport (held axes included),
-/// each segment e_j contributes (kb_before + kb_after) / (2 |e_j|) to its last node and minus that to its
-/// first. Zero on a straight rod: twisting alone does not move the nodes.
-void rodTwistGradient(const Rod& rod, const NodeArray& x, NodeArray& gradient);
+/// The twist interval after station s (to station s + 1): its length [m] between the two stations' nearest
+/// nodes (Rod::restLength between two held ends), and its slot in State::twist (station s's last node).
+double intervalLength(const Rod& rod, int s);
+inline int twistSlot(const Rod& rod, int s) { return rod.stations[static_cast<std::size_t>(s)].last; }
 
-/// Bending plus twisting energy [J] of the rod at x with total twist `twist`:
-///   sum over vertices of weight |kb|^2  +  G J twist^2 / (2 L)     (the twist term only if it twists).
-double rodEnergy(const Rod& rod, const NodeArray& x, double twist);
+/// The twist [rad] between stations s and s + 1 at x: the angle, about station s + 1's entering axis, from
+/// station s's leaving frame's y axis carried to it by parallel transport (through station s's leaving
+/// axis, every segment between them and station s + 1's entering axis) to station s + 1's entering frame's
+/// y axis; > 0 when the later station is turned right-handedly about the rod. Of the values 2 pi apart,
+/// the one nearest `near` (the last step's: a rod counts whole turns).
+double intervalTwist(const Rod& rod, int s, const NodeArray& x, double near);
 
-/// Adds the rod's bending and twisting forces -dE/dx [N] at x with total twist `twist` to `force` (3 x
-/// the model's nodes): -2 weight J_k^T kb at each vertex's nodes (J_k = dkb/dx_k), and
-/// -(G J twist / L) d(twist)/dx.
-void accumulateRodForces(const Rod& rod, const NodeArray& x, double twist, NodeArray& force);
+/// State::twist's entries of the rod updated to x (each interval's, counted on from its last value).
+void updateRodTwists(const Rod& rod, const NodeArray& x, Eigen::VectorXd& twist);
 
-/// Each segment's material frame at x with total twist `twist` (count - 1 of them): x along the segment;
-/// the first held frame (or, at a free first end, the rest frame turned onto the first segment) carried
-/// by parallel transport, and turned about the segment by twist times its midpoint's share of the length.
-void rodFrames(const Rod& rod, const NodeArray& x, double twist, std::vector<Eigen::Quaterniond>& frames);
+/// d(twist)/dx of the interval after station s, of each of the rod's nodes (3 x count, zero outside the
+/// interval; the twist's holonomy, DER section 6): with kb_k the curvature binormal of unit tangents at
+/// each bend of the transport (the held axes included), each segment e_j between the stations contributes
+/// (kb_before + kb_after) / (2 |e_j|) to its last node and minus that to its first. Zero on a straight
+/// rod: twisting alone does not move the nodes.
+void intervalTwistGradient(const Rod& rod, int s, const NodeArray& x, NodeArray& gradient);
 
-/// The torque [N m] the rod exerts on held end `end` (0: first node, 1: last) at x with total twist
-/// `twist`: its bending moment at the clamp, l (g x a) with g = dE/d(ghost edge) and a the held axis, and
-/// its twisting moment -+ G J twist / L about that axis. The twist's dependence on the held axis's
-/// direction (its holonomy through the clamp) is not included.
-Vec3 heldEndTorque(const Rod& rod, const NodeArray& x, double twist, int end);
+/// Adds the rod's twisting forces -(G J twist / L) d(twist)/dx [N] at x to `force` (3 x the model's nodes),
+/// each interval's twist counted at x on from its entry of State::twist `twist`.
+void accumulateTwistForces(const Rod& rod, const NodeArray& x, const Eigen::VectorXd& twist, NodeArray& force);
+
+/// Bending plus twisting energy [J] of the rod at x with the twists of State::twist `twist`:
+///   sum over vertices of weight |kb|^2  +  sum over intervals of G J twist^2 / (2 L_interval).
+double rodEnergy(const Rod& rod, const NodeArray& x, const Eigen::VectorXd& twist);
+
+/// Adds the rod's bending and twisting forces -dE/dx [N] at x to `force` (3 x the model's nodes):
+/// -2 weight J_k^T kb at each vertex's nodes (J_k = dkb/dx_k), and -(G J twist / L) d(twist)/dx per
+/// interval.
+void accumulateRodForces(const Rod& rod, const NodeArray& x, const Eigen::VectorXd& twist, NodeArray& force);
+
+/// Adds the rod's end moment (Rod::end_moment) at x to `force` (3 x the model's nodes): the couple
+/// F = M x e / |e|^2 on its last node and -F on the one before (e the last segment), whose moment is M's
+/// part across e. In a plane it is -d(-M theta)/dx for theta the last segment's angle: a dead moment.
+void accumulateRodEndMoment(const Rod& rod, const NodeArray& x, NodeArray& force);
+
+/// Each segment's material frame at x (count - 1 of them): x along the segment; between two stations the
+/// earlier station's leaving frame carried by parallel transport and turned about the segment by the
+/// interval's twist times its midpoint's share of the interval; beyond the outer stations the frame
+/// carried from them untwisted (a free end); a rod without stations carries its rest frame.
+void rodFrames(const Rod& rod, const NodeArray& x, const Eigen::VectorXd& twist, std::vector<Eigen::Quaterniond>& frames);
+
+/// The torque [N m] the rod exerts on station s at x, beyond its nodes' forces: at a station of one node
+/// its bending moment there, l (g x a) per ghost edge with g = dE/d(ghost edge) and a the held axis; and the
+/// twisting moments of the intervals on each side, -G J twist / L about the entering axis (the interval
+/// before) and +G J twist / L about the leaving axis (the one after). The twists' dependence on the held
+/// axes' directions (their holonomy through the station) is not included.
+Vec3 stationTorque(const Rod& rod, int s, const NodeArray& x, const Eigen::VectorXd& twist);
+
+/// Makes node `node` (global) of the rod a station of one node in the rest frame, held by a holder at rest
+/// (a clamp, a scene's anchor: RodStation::turn with its orientation); nothing if it is one already. For
+/// a rod at rest, before it steps.
+void clampRod(Rod& rod, int node);
+
+/// Holds nodes first .. last of the rod (pinned by the caller) as a new station, held by a holder at
+/// orientation `holder` (unit) now: the station keeps the material frames the rod has there now (rodFrames;
+/// at a station of one node, turned onto the mean of its two segments' directions) and turns with the
+/// holder (RodStation::turn). The interval it falls in splits in two, each twist counted on from its share
+/// of the old one. Returns the new station's index. Throws std::invalid_argument if the nodes overlap a
+/// station.
+int holdRod(Rod& rod, const NodeArray& x, Eigen::VectorXd& twist, int first, int last, const Eigen::Quaterniond& holder);
+
+/// Lets station s go: the intervals on each side join, their twist the sum of theirs and the station's own
+/// (between its two frames).
+void releaseRod(Rod& rod, const NodeArray& x, Eigen::VectorXd& twist, int s);
 
 }  // namespace soft_body_sim

@@ -73,8 +73,8 @@ public:
   /// Moves the anchor's (pinned) node to `position` [m] during the next step, at constant velocity,
   /// so that springs and dashpots feel a smooth motion. The latest call before a step wins.
   void moveAnchor(int anchor, const Vec3& position) { anchors_.setGoal(static_cast<std::size_t>(anchor), position); }
-  /// moveAnchor, and an anchor holding a rod's end also turns it to `orientation` (identity: as built;
-  /// AnchorSet::setGoal), at constant angular velocity the shorter way round: to turn an end further than
+  /// moveAnchor, and an anchor holding a rod (a scene's anchor on a rod) also turns it there to
+  /// `orientation` (identity: as built; AnchorSet::setGoal), at constant angular velocity the shorter way round: to turn an end further than
   /// half a turn, turn it over several steps (the rod counts the whole turns of its twist).
   void moveAnchor(int anchor, const Vec3& position, const Eigen::Quaterniond& orientation)
   {
@@ -158,10 +158,11 @@ public:
   /// Each link's tension [N] in the last sub-step, > 0 stretched: springs, then constraints, in model
   /// order (internalForces().tension).
   Eigen::VectorXd linkTensions() const { return internalForces().tension; }
-  /// Per anchor of model().anchors, the wrench its body exerts on it, torque about its node (a rod's held
-  /// end: its bending and twisting moment, heldEndTorque).
+  /// Per anchor of model().anchors, the wrench its body exerts on it, torque about its node (on a rod,
+  /// with the rod's bending and twisting moment there, stationTorque).
   std::vector<Wrench> anchorWrenches() const;
-  /// Per grasp of grasps(), the wrench its body exerts on it, torque about its frame's origin.
+  /// Per grasp of grasps(), the wrench its body exerts on it, torque about its frame's origin (on a rod,
+  /// with the rod's moments at the stations the grasp holds, stationTorque).
   std::vector<Wrench> graspWrenches() const;
 
   /// Kinetic + potential energy [J] (see forces.h).

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "soft_body_sim/core/rods.h"
+
 namespace soft_body_sim
 {
 BodyDef buildRod(const std::string& name, const RodDef& rod)
@@ -16,6 +18,7 @@ BodyDef buildRod(const std::string& name, const RodDef& rod)
   requireDefinition(shear_modulus > 0.0, what, { "shear_modulus" }, "shear_modulus must be > 0");
   requireDefinition(rod.density > 0.0, what, { "density" }, "density must be > 0");
   requireDefinition(rod.damping >= 0.0, what, { "damping" }, "damping must be >= 0");
+  requireDefinition(rod.end_moment.allFinite(), what, { "end_moment" }, "end_moment must be finite [N m]");
   requireSelfContact(what, rod.self_collision, rod.self_friction, rod.radius, "radius");
 
   const double area = M_PI * rod.radius * rod.radius;
@@ -48,21 +51,18 @@ BodyDef buildRod(const std::string& name, const RodDef& rod)
   bending.bending_stiffness = rod.youngs_modulus * second_moment;
   bending.twisting_stiffness = shear_modulus * 2.0 * second_moment;
   bending.damping = rod.damping;
+  bending.end_moment = rod.end_moment;
   // Frame at rest: x along the rod, y horizontal (across the rod and world z) unless the rod is vertical.
   Vec3 y = Vec3::UnitZ().cross(axis);
   y = y.norm() > 1e-9 ? Vec3(y.normalized()) : Vec3::UnitY();
   Eigen::Matrix3d frame;
   frame << axis, y, axis.cross(y);
   bending.rest_frame = Eigen::Quaterniond(frame);
-  bending.end_frame[0] = bending.end_frame[1] = bending.rest_frame;
   for (int index : rod.clamped)
   {
     const int node = resolveNodeIndex(index, rod.nodes);
-    requireDefinition(node == 0 || node == rod.nodes - 1, what, { "clamped" },
-                      "clamped node " + std::to_string(index) + " is not an end: only its ends (0, -1) can be "
-                      "clamped (a grasp holds it elsewhere)");
     body.nodes[static_cast<std::size_t>(node)].pinned = true;
-    bending.held[node == 0 ? 0 : 1] = true;
+    clampRod(bending, node);
   }
   body.rod = bending;
   return body;

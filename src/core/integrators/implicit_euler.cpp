@@ -43,6 +43,8 @@ using Matrix3 = Eigen::Matrix3d;
 /// (Rod::damping) enters D. Their twist's force -(G J twist / L) d(twist)/dx enters f only, explicitly:
 /// its stiffness is rank one and couples every node of the rod (a dense block), and against the bending's
 /// it is of order M_t l / (E I) for a twisting moment M_t, l / L near the critical twist of a long rod.
+/// A rod's end moment (a couple on its last segment) enters f only, explicitly too: its stiffness M / l^2
+/// is 2 pi l / L of the bending's E I / l^3 even at a full circle's moment 2 pi E I / L.
 /// A spring's 3x3 block is a u u^T + b I (below), a cell's h^2 S g_k g_l^T, a rod vertex's
 /// (h^2 + h beta) 2 w J_k^T J_l. The matrix's pattern (which
 /// node pairs couple) depends only on the springs, the cells and which nodes are pinned: it is analysed
@@ -60,8 +62,6 @@ public:
     const int n = model.nodeCount();
     start_x_ = state.position;
     start_v_ = state.velocity;
-    if (state.twist.size() != static_cast<Eigen::Index>(model.rods.size()))
-      state.twist.setZero(static_cast<Eigen::Index>(model.rods.size()));
     if (!analyzed_)
       analyze(model);
     for (int k = 0; k < iterations; ++k)
@@ -91,9 +91,8 @@ public:
       if (model.isFree(i))
         state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
     constraints_.apply(model, state, h, iterations);
-    for (std::size_t r = 0; r < model.rods.size(); ++r)
-      state.twist[static_cast<Eigen::Index>(r)] =
-          rodTwist(model.rods[r], state.position, state.twist[static_cast<Eigen::Index>(r)]);
+    for (const Rod& rod : model.rods)
+      updateRodTwists(rod, state.position, state.twist);
   }
 
 private:
@@ -219,8 +218,8 @@ private:
 
   /// The rods' bending blocks (on the diagonal here; off it in multiply and solveDirectly) and their
   /// bending, damping and twist forces in rhs_: per vertex, with q = sum_l J_l offset_l and
-  /// r = sum_l J_l v_l, rhs_k -= 2 w h J_k^T (kb + q + beta r); per rod that twists,
-  /// rhs_i -= h (G J twist / L) d(twist)/dx_i.
+  /// r = sum_l J_l v_l, rhs_k -= 2 w h J_k^T (kb + q + beta r); per interval between two stations,
+  /// rhs_i -= h (G J twist / L) d(twist)/dx_i; and h times the rods' end moments.
   void addRods(const Model& model, const NodeArray& x, const NodeArray& v, const Eigen::VectorXd& twist, double h)
   {
     rod_blocks_.resize(rod_vertices_.size());
@@ -261,18 +260,15 @@ private:
         diagonal_[static_cast<std::size_t>(node)] += block.scale * block.jacobian[c].transpose() * block.jacobian[c];
       }
     }
-    for (std::size_t r = 0; r < model.rods.size(); ++r)
+    force_.setZero(3, model.nodeCount());
+    for (const Rod& rod : model.rods)
     {
-      const Rod& rod = model.rods[r];
-      if (!rod.twists())
-        continue;
-      rodTwistGradient(rod, x, twist_gradient_);
-      const double moment =
-          rod.twisting_stiffness * rodTwist(rod, x, twist[static_cast<Eigen::Index>(r)]) / rod.restLength();
-      for (int j = 0; j < rod.count; ++j)
-        if (model.isFree(rod.first + j))
-          rhs_.col(rod.first + j) -= h * moment * twist_gradient_.col(j);
+      accumulateTwistForces(rod, x, twist, force_);
+      accumulateRodEndMoment(rod, x, force_);
     }
+    for (int i = 0; i < model.nodeCount(); ++i)
+      if (model.isFree(i))
+        rhs_.col(i) += h * force_.col(i);
   }
 
   /// Block Jacobi for conjugate gradients: the inverse of each node's full 3x3 diagonal block (springs'
@@ -553,7 +549,7 @@ private:
   static constexpr std::array<std::pair<int, int>, 3> kRodPairs{ { { 0, 1 }, { 0, 2 }, { 1, 2 } } };
 
   NodeArray start_x_, start_v_, linear_x_, offset_;
-  NodeArray force_;  ///< the cells' pressure forces [N]
+  NodeArray force_;  ///< the cells' pressure forces [N], then the rods' twisting forces and end moments
   NodeArray rhs_, delta_v_;
   NodeArray residual_, direction_, z_, product_;  ///< conjugate gradients' vectors
   std::vector<Matrix3> diagonal_;        ///< per node: mass and spring blocks of A
@@ -575,7 +571,6 @@ private:
   std::vector<int> rod_of_vertex_;       ///< per rod vertex: its rod's index in Model::rods
   std::vector<RodBlock> rod_blocks_;     ///< per rod vertex
   std::vector<int> rod_slot_;            ///< per rod vertex, three: each node pair's slot, or -1
-  NodeArray twist_gradient_;             ///< d(twist)/dx of one rod (rodTwistGradient)
 };
 }  // namespace
 

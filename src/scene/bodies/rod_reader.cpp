@@ -7,7 +7,7 @@ namespace soft_body_sim::scene_yaml
 BodyDef readRodBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nodes", "from", "to", "radius", "youngs_modulus", "shear_modulus",
-                                              "density", "damping", "clamped", "self_collision", "self_friction" }));
+                                              "density", "damping", "clamped", "end_moment", "self_collision", "self_friction" }));
   RodDef rod;
   const Field nodes = requiredKey(ctx, field, "nodes");
   rod.nodes = readCount(ctx, nodes, 2);
@@ -23,6 +23,8 @@ BodyDef readRodBody(const Context& ctx, const Field& field, const SceneSoFar& sc
     rod.damping = readNumber(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "clamped"))
     rod.clamped = readPinned(ctx, *value, rod.nodes);
+  if (const std::optional<Field> value = optionalKey(field, "end_moment"))
+    rod.end_moment = readVec3(ctx, *value);
   readSelfContact(ctx, field, rod);
   return buildBody(ctx, field, rod, buildRod);
 }

@@ -22,7 +22,9 @@ struct RodDef
   /// beta [s] >= 0: stiffness-proportional (Rayleigh) damping of its stretching and bending, a force
   /// -beta K v; a bending mode of angular frequency omega decays at the rate beta omega^2 / 2.
   double damping = 0.0;
-  std::vector<int> clamped;               ///< its ends (0, -1) whose position and orientation are held
+  std::vector<int> clamped;               ///< nodes whose position and orientation are held (negative from the end)
+  /// [N m] a constant moment on its last node about fixed world axes (Rod::end_moment); needs that node free
+  Vec3 end_moment = Vec3::Zero();
   bool self_collision = false;            ///< its segments keep apart by its radius (as a rope's)
   double self_friction = 0.0;             ///< Coulomb coefficient [-] between touching segments, >= 0
 };
