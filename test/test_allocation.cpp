@@ -245,9 +245,9 @@ TEST(StepAllocation, ImplicitEulerOnChainsAllocatesNothing)
   EXPECT_TRUE(world.state().position.allFinite());
 }
 
-// A rod (rods.h) clamped at one end, its other end anchored and turned while it moves: bending blocks,
-// the twist's gradient and the anchor's turn.
-TEST(StepAllocation, ImplicitEulerOnARodTurnedByItsAnchorAllocatesNothing)
+// A rod (rods.h) clamped at one end, its other end anchored and turned while it moves, a grasp turning in
+// its middle: bending blocks, the twists' gradients, the anchor's and the grasp's turns.
+TEST(StepAllocation, ImplicitEulerOnARodTurnedByItsAnchorAndAGraspAllocatesNothing)
 {
   SceneDef scene;
   scene.physics.integrator = IntegratorType::ImplicitEuler;
@@ -260,19 +260,22 @@ TEST(StepAllocation, ImplicitEulerOnARodTurnedByItsAnchorAllocatesNothing)
   scene.bodies.push_back(body);
   World world = buildWorld(scene);
   const int tip = *world.findAnchor("cable", "tip");
+  const Vec3 middle = world.state().position.col(15);
+  world.grasp("hand", "cable", RigidPose{ middle, Eigen::Quaterniond::Identity() }, 0.01);
   world.step();
   const long allocations = allocationsOf([&] {
     for (int n = 0; n < 200; ++n)
     {
       world.moveAnchor(tip, Vec3(1.0 - 0.001 * n, 0.0, 1.0), Eigen::Quaterniond(Eigen::AngleAxisd(0.05 * n, Vec3::UnitX())));
+      world.moveGrasp("hand", RigidPose{ middle, Eigen::Quaterniond(Eigen::AngleAxisd(-0.02 * n, Vec3::UnitX())) });
       world.step();
     }
   });
   EXPECT_EQ(allocations, 0);
   EXPECT_TRUE(world.state().position.allFinite());
-  // Turned 9.95 rad: its twist counts on past whole turns (less than that: some of the turn went into
-  // its writhe as it sagged out of line).
-  EXPECT_GT(world.state().twist[0], 2.0 * M_PI);
+  // Turned 9.95 rad against the grasp's -3.98: the twist after the grasp counts on past whole turns (less
+  // than their difference: some of the turn went into its writhe as it sagged out of line).
+  EXPECT_GT(world.state().twist[15], 2.0 * M_PI);
 }
 
 TEST(StepAllocation, TheCounterSeesOperatorNewAndEigen)

@@ -2,7 +2,8 @@
 """A rod the ROS way (launched by rod.test on config/scenes/cable.yaml): a pose with an orientation
 published to the tip anchor's topic turns the cable's end, and the anchor's wrench topic carries the
 twisting moment G J phi / L; a pose whose orientation is all zeros moves the tip without turning it;
-the markers draw the cable as a strip of its diameter and its segments' frames."""
+a grasp on its middle in a turning tf frame twists both halves, and its wrench topic carries both
+halves' moments; the markers draw the cable as a strip of its diameter and its segments' frames."""
 import math
 
 import rospy
@@ -10,7 +11,8 @@ import rostest
 from geometry_msgs.msg import PoseStamped, WrenchStamped
 from visualization_msgs.msg import Marker, MarkerArray
 
-from node_client import NodeTestCase, StateWatcher, wait_for
+from node_client import FrameBroadcaster, NodeTestCase, StateWatcher, wait_for
+from soft_body_sim.srv import Detach, Grasp
 
 NODE = "/soft_body_sim"
 RADIUS = 0.005           # [m], cable.yaml
@@ -39,6 +41,10 @@ class RodNodeTest(NodeTestCase):
         cls.markers = []
         rospy.Subscriber(NODE + "/markers", MarkerArray, cls.markers.append, queue_size=10)
         cls.tip = rospy.Publisher(NODE + "/cable/tip/pose", PoseStamped, queue_size=100)
+        cls.frames = FrameBroadcaster()
+        rospy.wait_for_service(NODE + "/grasp", 20.0)
+        cls.grasp = rospy.ServiceProxy(NODE + "/grasp", Grasp)
+        cls.release = rospy.ServiceProxy(NODE + "/release", Detach)
         cls.state.next(1, 20.0)
 
     def settle(self):
@@ -50,6 +56,38 @@ class RodNodeTest(NodeTestCase):
         count = len(self.wrenches)
         self.assertTrue(wait_for(lambda: len(self.wrenches) > count + 2, 10.0), "no wrench on ~cable/tip/wrench")
         return self.wrenches[-1].wrench.torque
+
+    def test_a_grasp_turned_in_the_middle_twists_both_halves(self):
+        # A gripper closes on the middle node (the cable is level there) and turns 1 rad about the cable in
+        # 2 s: each half, 0.5 m between it and a held end, twists by 1 rad, and the gripper feels both,
+        # -G J phi (1 / 0.5 + 1 / 0.5) about x. Released, the two twists cancel: the cable is untwisted.
+        self.settle()
+        middle = self.state.node("cable", 20)
+        start = rospy.Time.now().to_sec() + 1.0
+
+        def hand(t):
+            angle = min(1.0, max(0.0, (t - start) / 2.0))
+            return middle, (math.sin(angle / 2), 0.0, 0.0, math.cos(angle / 2))
+
+        self.frames.set("hand", hand)
+        self.assertTrue(wait_for(lambda: rospy.Time.now().to_sec() > start - 0.5, 5.0))
+        response = self.grasp(frame="hand", body="cable", radius=0.01, max_force=0.0)
+        self.assertTrue(response.success, response.message)
+        self.assertEqual(list(response.nodes), [20])
+        wrenches = []
+        subscriber = rospy.Subscriber(NODE + "/cable/hand/wrench", WrenchStamped, wrenches.append, queue_size=10)
+        try:
+            self.assertTrue(wait_for(lambda: rospy.Time.now().to_sec() > start + 2.5, 10.0))
+            self.settle()
+            count = len(wrenches)
+            self.assertTrue(wait_for(lambda: len(wrenches) > count + 2, 10.0), "no wrench on ~cable/hand/wrench")
+            self.assertAlmostEqual(wrenches[-1].wrench.torque.x, -TWISTING * 1.0 * (2 / LENGTH + 2 / LENGTH),
+                                   delta=0.05 * 4 * TWISTING)
+        finally:
+            subscriber.unregister()
+        self.assertTrue(self.release(frame="hand").success)
+        self.settle()
+        self.assertAlmostEqual(self.latest_torque().x, 0.0, delta=1e-6)
 
     def test_the_tip_pose_twists_the_cable_and_its_wrench_carries_the_twisting_moment(self):
         self.settle()
