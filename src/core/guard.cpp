@@ -68,8 +68,8 @@ std::vector<DivergenceGuard::Catch> DivergenceGuard::restoreDiverged(const Model
         state.position.col(i) = last_good_.position.col(i);
         state.velocity.col(i) = last_good_.velocity.col(i);
       }
-    // A rod's twists (State::twist, one entry per node) go back with its nodes: a twist counted on from a
-    // non-finite one would stay non-finite.
+    // A rod's twists (State::twist, one entry per node) go back with its nodes: the whole body's state is
+    // the saved one, not its positions with the twists counted at the diverged step.
     if (state.twist.size() > 0)
       state.twist.segment(body.first, body.count) = last_good_.twist.segment(body.first, body.count);
     caught.push_back({ b, std::move(reason) });
