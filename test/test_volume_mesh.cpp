@@ -1,21 +1,17 @@
 // The tetrahedral mesher (bodies/volume_mesh.h) against truths of geometry that do not come from it: the
 // box's volume and area, the divergence theorem's volume of a surface, the sphere's inscribed
-// polyhedron between two balls, Euler's rule that a closed surface shares every edge by two triangles,
-// and TetGen's quality bound checked from the node positions.
+// polyhedron held between two balls, a closed oriented surface running each edge once each way, and
+// TetGen's radius-edge bound checked from the node positions.
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <unistd.h>
 
 #include <gtest/gtest.h>
 
@@ -36,8 +32,9 @@ double radiusEdgeRatio(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const
                        const Eigen::Vector3d& d)
 {
   const Eigen::Vector3d u = b - a, v = c - a, w = d - a;
-  const Eigen::Vector3d x = (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u) + w.squaredNorm() * u.cross(v)) /
-                            (2.0 * u.dot(v.cross(w)));
+  const Eigen::Vector3d x =
+      (u.squaredNorm() * v.cross(w) + v.squaredNorm() * w.cross(u) + w.squaredNorm() * u.cross(v)) /
+      (2.0 * u.dot(v.cross(w)));
   const double shortest = std::min({ u.norm(), v.norm(), w.norm(), (c - b).norm(), (d - b).norm(), (d - c).norm() });
   return x.norm() / shortest;
 }
@@ -117,7 +114,8 @@ TriangleMesh cube(const Eigen::Vector3d& centre, double half)
 {
   TriangleMesh mesh;
   for (int corner = 0; corner < 8; ++corner)  // bit 0: +x, bit 1: +y, bit 2: +z
-    mesh.vertices.push_back(centre + half * Eigen::Vector3d(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1));
+    mesh.vertices.push_back(centre +
+                            half * Eigen::Vector3d(corner & 1 ? 1 : -1, corner & 2 ? 1 : -1, corner & 4 ? 1 : -1));
   for (const std::array<int, 4>& q : std::vector<std::array<int, 4>>{
            { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 } })
   {
@@ -125,47 +123,6 @@ TriangleMesh cube(const Eigen::Vector3d& centre, double half)
     mesh.triangles.emplace_back(q[0], q[2], q[3]);
   }
   return mesh;
-}
-
-/// The L-shaped prism: the polygon (0,0) (2,0) (2,1) (1,1) (1,2) (0,2) times `scale` [m], extruded from
-/// z = 0 to `scale`; volume 3 scale^3.
-TriangleMesh lPrism(double scale)
-{
-  const std::vector<Eigen::Vector2d> outline{ { 0, 0 }, { 2, 0 }, { 2, 1 }, { 1, 1 }, { 1, 2 }, { 0, 2 } };
-  TriangleMesh mesh;
-  for (double z : { 0.0, 1.0 })
-    for (const Eigen::Vector2d& p : outline)
-      mesh.vertices.push_back(scale * Eigen::Vector3d(p.x(), p.y(), z));
-  // Caps: a fan from the reflex corner 3, counter-clockwise seen from +z on top, turned on the bottom.
-  for (int k : { 4, 5, 0, 1 })
-  {
-    const int next = (k + 1) % 6;
-    mesh.triangles.emplace_back(3 + 6, k + 6, next + 6);
-    mesh.triangles.emplace_back(3, next, k);
-  }
-  for (int k = 0; k < 6; ++k)  // sides: outward, as the outline runs counter-clockwise
-  {
-    const int next = (k + 1) % 6;
-    mesh.triangles.emplace_back(k, next, next + 6);
-    mesh.triangles.emplace_back(k, next + 6, k + 6);
-  }
-  return mesh;
-}
-
-/// `mesh` written as an ASCII STL file at `path`.
-void writeStl(const TriangleMesh& mesh, const std::string& path)
-{
-  std::ofstream out(path);
-  out.precision(17);
-  out << "solid test\n";
-  for (const Eigen::Vector3i& t : mesh.triangles)
-  {
-    out << "facet normal 0 0 0\nouter loop\n";
-    for (int k = 0; k < 3; ++k)
-      out << "vertex " << mesh.vertices[t[k]].x() << ' ' << mesh.vertices[t[k]].y() << ' ' << mesh.vertices[t[k]].z() << '\n';
-    out << "endloop\nendfacet\n";
-  }
-  out << "endsolid test\n";
 }
 
 /// The message of the DefinitionError that `make` throws, or "" if it throws none.
@@ -200,14 +157,30 @@ TEST(VolumeMesh, BoxFillsItsVolumeAndItsSurfaceIsItsFaces)
   EXPECT_LT(meanEdge(mesh), 1.5 * resolution);
 }
 
-TEST(VolumeMesh, BoxNodesGrowAsTheCubeOfOneOverResolution)
+/// The number of nodes on the mesh's surface.
+std::size_t surfaceNodes(const TetMesh& mesh)
+{
+  std::set<int> nodes;
+  for (const std::array<int, 3>& f : mesh.surface)
+    nodes.insert(f.begin(), f.end());
+  return nodes.size();
+}
+
+TEST(VolumeMesh, BoxRefinesAsTheCubeOfOneOverResolution)
 {
   const Eigen::Vector3d size(0.2, 0.2, 0.2);
   const TetMesh coarse = meshBox(size, 0.02), fine = meshBox(size, 0.01);
-  const double ratio = static_cast<double>(fine.nodes.size()) / static_cast<double>(coarse.nodes.size());
-  // 8 in the interior's limit; the surface's nodes, a share ~ 1/n of them, grow only 4 times.
-  EXPECT_GT(ratio, 5.0);
-  EXPECT_LT(ratio, 10.0);
+  const auto ratio = [](std::size_t fine_count, std::size_t coarse_count) {
+    return static_cast<double>(fine_count) / static_cast<double>(coarse_count);
+  };
+  // Halving the resolution: the tetrahedra, filling the volume, grow 2^3 = 8 times, the surface's nodes
+  // 2^2 = 4 times, and all nodes in between (10 to 20 tetrahedra across, half of them on the surface).
+  EXPECT_GT(ratio(fine.tets.size(), coarse.tets.size()), 6.0);
+  EXPECT_LT(ratio(fine.tets.size(), coarse.tets.size()), 10.0);
+  EXPECT_GT(ratio(surfaceNodes(fine), surfaceNodes(coarse)), 3.0);
+  EXPECT_LT(ratio(surfaceNodes(fine), surfaceNodes(coarse)), 5.0);
+  EXPECT_GT(ratio(fine.nodes.size(), coarse.nodes.size()), 4.0);
+  EXPECT_LT(ratio(fine.nodes.size(), coarse.nodes.size()), 8.0);
   EXPECT_GT(meanEdge(fine), 0.5 * 0.01);
   EXPECT_LT(meanEdge(fine), 1.5 * 0.01);
 }
@@ -250,21 +223,19 @@ TEST(VolumeMesh, SphereIsItsInscribedPolyhedron)
 
 TEST(VolumeMesh, ClosedStlFillsItsDivergenceVolume)
 {
-  const std::string path =
-      (std::filesystem::temp_directory_path() / ("test_volume_mesh_" + std::to_string(getpid()) + ".stl")).string();
-  writeStl(lPrism(0.1), path);
-  const TriangleMesh surface = readTriangleMesh(path, Eigen::Vector3d::Ones());
-  std::filesystem::remove(path);
-  const double exact = 3.0 * 0.1 * 0.1 * 0.1;
-  // ASCII STL is read in single precision: the corners move by ~1e-8 of their size.
-  ASSERT_NEAR(enclosedVolume(surface), exact, 1e-6 * exact);
-  const double resolution = 0.02;
+  // The example bracket (scripts/make_part_stl.py): an L-shaped profile of area 0.1 x 0.02 + 0.02 x 0.06
+  // [m^2] extruded 0.06 m, not convex.
+  const TriangleMesh surface = readTriangleMesh(SOURCE_DIR "/config/meshes/part.stl", Eigen::Vector3d::Ones());
+  const double exact = (0.1 * 0.02 + 0.02 * 0.06) * 0.06, enclosed = enclosedVolume(surface);
+  ASSERT_NEAR(enclosed, exact, 1e-6 * exact);  // a binary STL holds single-precision corners
+  const double resolution = 0.01;
   const TetMesh mesh = meshSurface(surface, resolution);
-  const double enclosed = enclosedVolume(surface);
   EXPECT_NEAR(meshVolume(mesh), enclosed, 1e-9 * enclosed);
   EXPECT_NEAR(enclosedVolume(surfaceOf(mesh)), enclosed, 1e-9 * enclosed);
   expectClosedAndOriented(mesh);
   expectQuality(mesh, resolution);
+  EXPECT_GT(meanEdge(mesh), 0.5 * resolution);
+  EXPECT_LT(meanEdge(mesh), 1.5 * resolution);
 }
 
 TEST(VolumeMesh, InwardSurfaceMeshesTheSameSolid)
@@ -305,6 +276,20 @@ TEST(VolumeMesh, SelfIntersectingSurfaceIsRefused)
     both.triangles.push_back(t + Eigen::Vector3i::Constant(offset));
   const std::string message = definitionError([&] { meshSurface(both, 0.02); });
   EXPECT_NE(message.find("the surface intersects itself"), std::string::npos) << message;
+  EXPECT_NE(message.find("of its triangles cross another (tetgen -d), the first triangle"), std::string::npos)
+      << message;
+}
+
+TEST(VolumeMesh, CavityIsRefused)
+{
+  TriangleMesh hollow = cube(Eigen::Vector3d::Zero(), 0.05);
+  TriangleMesh cavity = cube(Eigen::Vector3d::Zero(), 0.02);
+  const int offset = static_cast<int>(hollow.vertices.size());
+  hollow.vertices.insert(hollow.vertices.end(), cavity.vertices.begin(), cavity.vertices.end());
+  for (const Eigen::Vector3i& t : cavity.triangles)
+    hollow.triangles.emplace_back(t[0] + offset, t[2] + offset, t[1] + offset);  // facing into the cavity
+  const std::string message = definitionError([&] { meshSurface(hollow, 0.02); });
+  EXPECT_NE(message.find("a shell lies inside another (a cavity is not supported)"), std::string::npos) << message;
 }
 
 TEST(VolumeMesh, BadSizesAndResolutionsAreRefused)
@@ -325,13 +310,18 @@ TEST(VolumeMesh, BadSizesAndResolutionsAreRefused)
     EXPECT_NE(definitionError([&] { meshBox(flat, 0.01); }).find("size must be > 0 in x, y and z"), std::string::npos);
   }
   EXPECT_NE(definitionError([&] { meshSphere(0.0, 0.01); }).find("radius must be > 0"), std::string::npos);
-  // 4.5 V / (h^3 / (6 sqrt 2)) at V = 1 m^3, h = 1 cm: 3.8e7 tetrahedra.
-  EXPECT_NE(definitionError([&] { meshBox(Eigen::Vector3d::Ones(), 0.01); }).find("too fine"), std::string::npos);
+  // kTetsPerMaxVolume V / v_max = 3.5 x 1 m^3 / (1e-6 m^3 / (2 sqrt 2)): 9.9e6 tetrahedra.
+  const std::string message = definitionError([&] { meshBox(Eigen::Vector3d::Ones(), 0.01); });
+  EXPECT_NE(message.find("resolution 0.01 m is too fine: it would make about 9899495 tetrahedra"), std::string::npos)
+      << message;
+  EXPECT_NE(message.find("over the limit of 2000000"), std::string::npos) << message;
 }
 
 TEST(VolumeMesh, MissingTetgenIsNamed)
 {
-  const std::string path = std::getenv("PATH");
+  const char* const path_set = std::getenv("PATH");
+  ASSERT_NE(path_set, nullptr);
+  const std::string path = path_set;
   setenv("PATH", "/nonexistent", 1);
   std::string message;
   try

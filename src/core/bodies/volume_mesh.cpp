@@ -26,6 +26,9 @@ namespace soft_body_sim
 {
 namespace
 {
+/// The relative difference allowed between the tetrahedra's volume and the surface's enclosed one.
+constexpr double kVolumeAgreement = 1e-9;
+
 std::string str(double value)
 {
   std::ostringstream out;
@@ -52,8 +55,9 @@ void requireResolution(double resolution, double volume, const std::string& what
                     "resolution must be > 0 (the target edge length [m]), not " + str(resolution));
   const double estimate = kTetsPerMaxVolume * volume / maxTetVolume(resolution);
   requireDefinition(estimate <= kMaxTetrahedra, what, { "resolution" },
-                    "resolution " + str(resolution) + " m is too fine: it would make about " + str(estimate) +
-                        " tetrahedra, over the limit of " + str(kMaxTetrahedra) + "; choose a coarser one");
+                    "resolution " + str(resolution) + " m is too fine: it would make about " +
+                        std::to_string(std::llround(estimate)) + " tetrahedra, over the limit of " +
+                        std::to_string(std::llround(kMaxTetrahedra)) + "; choose a coarser one");
 }
 
 /// The faces of the tetrahedra (a, b, c, d) that belong to one only, each turned out of its tetrahedron.
@@ -63,13 +67,17 @@ std::vector<std::array<int, 3>> boundaryFaces(const std::vector<std::array<int, 
   std::vector<std::pair<std::array<int, 3>, std::array<int, 3>>> faces;  // (sorted key, oriented face)
   faces.reserve(4 * tets.size());
   for (const std::array<int, 4>& t : tets)
-    for (const std::array<int, 3>& face : { std::array<int, 3>{ t[0], t[2], t[1] }, std::array<int, 3>{ t[0], t[1], t[3] },
-                                            std::array<int, 3>{ t[0], t[3], t[2] }, std::array<int, 3>{ t[1], t[2], t[3] } })
+  {
+    const std::array<int, 3> outward[4] = {
+      { t[0], t[2], t[1] }, { t[0], t[1], t[3] }, { t[0], t[3], t[2] }, { t[1], t[2], t[3] }
+    };
+    for (const std::array<int, 3>& face : outward)
     {
       std::array<int, 3> key = face;
       std::sort(key.begin(), key.end());
       faces.emplace_back(key, face);
     }
+  }
   std::sort(faces.begin(), faces.end());
   std::vector<std::array<int, 3>> boundary;
   for (std::size_t k = 0; k < faces.size();)
@@ -95,33 +103,39 @@ TetMesh meshPlc(const Plc& plc, double resolution)
   return mesh;
 }
 
+/// The icosahedron of corners (0, +-1, +-phi), (+-1, +-phi, 0), (+-phi, 0, +-1), phi = (1 + sqrt 5) / 2:
+/// edges 2 long; its 20 faces, the triples of corners at mutual distance 2, facing outward.
+Plc icosahedron()
+{
+  const double phi = 0.5 * (1.0 + std::sqrt(5.0));
+  Plc ico;
+  for (double s : { -1.0, 1.0 })
+    for (double t : { -phi, phi })
+    {
+      ico.vertices.emplace_back(0.0, s, t);
+      ico.vertices.emplace_back(s, t, 0.0);
+      ico.vertices.emplace_back(t, 0.0, s);
+    }
+  const auto edge = [&](int i, int j) { return std::abs((ico.vertices[i] - ico.vertices[j]).norm() - 2.0) < 1e-9; };
+  for (int a = 0; a < 12; ++a)
+    for (int b = a + 1; b < 12; ++b)
+      for (int c = b + 1; c < 12; ++c)
+        if (edge(a, b) && edge(b, c) && edge(a, c))
+        {
+          const Eigen::Vector3d& A = ico.vertices[a];
+          const bool outward = (ico.vertices[b] - A).cross(ico.vertices[c] - A).dot(A) > 0.0;
+          ico.facets.push_back(outward ? std::vector<int>{ a, b, c } : std::vector<int>{ a, c, b });
+        }
+  return ico;
+}
+
 /// The geodesic sphere of `radius` [m]: each of the icosahedron's edges split into `n` parts, each of
 /// its faces into n^2 triangles, every point projected onto the sphere; triangles face outward.
 Plc geodesicSphere(double radius, int n)
 {
-  const double phi = 0.5 * (1.0 + std::sqrt(5.0));
+  const Plc ico = icosahedron();
   Plc sphere;
-  for (double s : { -1.0, 1.0 })
-    for (double t : { -phi, phi })
-    {
-      sphere.vertices.emplace_back(0.0, s, t);
-      sphere.vertices.emplace_back(s, t, 0.0);
-      sphere.vertices.emplace_back(t, 0.0, s);
-    }
-  // The icosahedron's faces: the triples of its 12 corners at mutual distance 2 (its edge).
-  std::vector<std::array<int, 3>> corners;
-  for (int a = 0; a < 12; ++a)
-    for (int b = a + 1; b < 12; ++b)
-      for (int c = b + 1; c < 12; ++c)
-      {
-        const auto edge = [&](int i, int j) { return std::abs((sphere.vertices[i] - sphere.vertices[j]).norm() - 2.0) < 1e-9; };
-        if (edge(a, b) && edge(b, c) && edge(a, c))
-        {
-          const Eigen::Vector3d& A = sphere.vertices[a];
-          const bool outward = (sphere.vertices[b] - A).cross(sphere.vertices[c] - A).dot(A) > 0.0;
-          corners.push_back(outward ? std::array<int, 3>{ a, b, c } : std::array<int, 3>{ a, c, b });
-        }
-      }
+  sphere.vertices = ico.vertices;
   // The points of an edge's interior, numbered once from its lower corner towards its higher one.
   std::map<std::pair<int, int>, std::vector<int>> edge_points;
   const auto edgePoint = [&](int from, int to, int step) {
@@ -135,7 +149,7 @@ Plc geodesicSphere(double radius, int n)
       }
     return points[static_cast<std::size_t>((from == low ? step : n - step) - 1)];
   };
-  for (const std::array<int, 3>& face : corners)
+  for (const std::vector<int>& face : ico.facets)
   {
     const int A = face[0], B = face[1], C = face[2];
     // Lattice point (i, j) = A + i (B - A) / n + j (C - A) / n, for i, j >= 0, i + j <= n.
@@ -228,7 +242,7 @@ void requireMeshableSurface(const TriangleMesh& surface, const std::string& what
     requireDefinition(tri.minCoeff() >= 0 && tri.maxCoeff() < vertices, what, { "mesh" },
                       "triangle " + std::to_string(t) + " names a vertex that does not exist");
     requireDefinition(tri[0] != tri[1] && tri[1] != tri[2] && tri[2] != tri[0], what, { "mesh" },
-                      "triangle " + std::to_string(t) + " repeats vertex; it has no area");
+                      "triangle " + std::to_string(t) + " repeats a vertex; it has no area");
   }
   for (const Eigen::Vector3d& v : surface.vertices)
     requireDefinition(v.allFinite(), what, { "mesh" }, "a vertex is not finite: " + str(v));
@@ -290,8 +304,10 @@ TetMesh meshBox(const Eigen::Vector3d& size, double resolution)
   requireResolution(resolution, size.prod(), what);
   Plc box;
   for (int corner = 0; corner < 8; ++corner)  // bit 0: +x, bit 1: +y, bit 2: +z
-    box.vertices.push_back(0.5 * size.cwiseProduct(
-                                     Eigen::Vector3d(corner & 1 ? 1.0 : -1.0, corner & 2 ? 1.0 : -1.0, corner & 4 ? 1.0 : -1.0)));
+  {
+    const Eigen::Vector3d side(corner & 1 ? 1.0 : -1.0, corner & 2 ? 1.0 : -1.0, corner & 4 ? 1.0 : -1.0);
+    box.vertices.push_back(0.5 * size.cwiseProduct(side));
+  }
   box.facets = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 } };
   return meshPlc(box, resolution);
 }
@@ -323,7 +339,16 @@ TetMesh meshSurface(const TriangleMesh& surface, double resolution)
                               ", " + str(surface.vertices[first[1]]) + ", " + str(surface.vertices[first[2]]),
                           { "mesh" });
   }
-  return meshPlc(plc, resolution);
+  TetMesh mesh = meshPlc(plc, resolution);
+  // TetGen fills every region the facets close off, a cavity too; the divergence theorem counts an
+  // inner shell with its sign. The two agree (to rounding, ~1e-16 per tetrahedron) only for shells side
+  // by side that all face the same way.
+  const double filled = meshVolume(mesh), enclosed = std::abs(enclosedVolume(surface));
+  requireDefinition(std::abs(filled - enclosed) <= kVolumeAgreement * enclosed, what, { "mesh" },
+                    "the tetrahedra fill " + str(filled) + " m^3 but the surface encloses " + str(enclosed) +
+                        " m^3 (divergence theorem): a shell lies inside another (a cavity is not supported) or "
+                        "its shells face different ways");
+  return mesh;
 }
 
 }  // namespace soft_body_sim

@@ -74,7 +74,9 @@ TetMesh meshSphere(double radius, double resolution);
 /// outward or all inward. Throws DefinitionError (keys "mesh", "resolution")
 /// when `resolution` is not > 0, the surface is open (an edge not shared by exactly two triangles),
 /// inconsistently oriented (two triangles run a shared edge the same way), intersects itself (TetGen -d),
-/// or the mesh would exceed kMaxTetrahedra; the message names the edge or triangle at fault.
+/// has a shell inside another (a cavity: TetGen would fill it) or shells facing different ways (then
+/// the tetrahedra's volume differs from the surface's enclosedVolume by over 1e-9 of it), or the mesh
+/// would exceed kMaxTetrahedra; the message names the edge or triangle at fault.
 TetMesh meshSurface(const TriangleMesh& surface, double resolution);
 
 }  // namespace soft_body_sim
