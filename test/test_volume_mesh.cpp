@@ -71,9 +71,11 @@ double meanEdge(const TetMesh& mesh)
   return sum / static_cast<double>(edges.size());
 }
 
-/// Every tetrahedron positive, none thinner than the floor 1e-3 resolution^3 / 6 [m^3] (a sliver, flat
-/// with a fine radius-edge ratio, would be); those with no node on the surface within TetGen's
-/// radius-edge bound, up to 2 % for its node smoothing after refinement (volume_mesh.h).
+/// Every tetrahedron positive and none thinner than the floor 1e-3 resolution^3 / 6 [m^3], which
+/// excludes slivers (flat, though of a fine radius-edge ratio) that no bound of TetGen's does (the
+/// thinnest measured: 1.5e-3 on part.stl, 5e-3 and more on boxes and spheres); those with no node on
+/// the surface within 5 % of TetGen's radius-edge bound, which its optimisation after refinement moves
+/// (volume_mesh.h).
 void expectQuality(const TetMesh& mesh, double resolution)
 {
   ASSERT_FALSE(mesh.tets.empty());
@@ -90,7 +92,7 @@ void expectQuality(const TetMesh& mesh, double resolution)
       worst_ratio = std::max(worst_ratio, radiusEdgeRatio(a, b, c, d));
   }
   EXPECT_GT(smallest, 1e-3 * resolution * resolution * resolution / 6.0);
-  EXPECT_LE(worst_ratio, 1.02 * kRadiusEdgeBound);
+  EXPECT_LE(worst_ratio, 1.05 * kRadiusEdgeBound);
 }
 
 /// Every edge of the surface is run once each way by two of its triangles: closed and consistently

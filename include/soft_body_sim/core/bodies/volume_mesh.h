@@ -41,17 +41,20 @@ double enclosedVolume(const TriangleMesh& surface);
 /// from the shape's volume V [m^3] and the volume bound v_max = resolution^3 / (2 sqrt 2) [m^3] that the
 /// mesh is made with, may not exceed it; a finer resolution is refused.
 constexpr double kMaxTetrahedra = 2.0e6;
-/// Tetrahedra per v_max of volume in TetGen's quality meshes: measured 3.0 to 3.3 on boxes and spheres
-/// of 10 to 20 tetrahedra across, where the interior dominates as in any mesh near the limit (a mesh a
-/// few tetrahedra across has more, its surface's layer of smaller tetrahedra counting).
+/// Tetrahedra per v_max of volume in TetGen's quality meshes: measured 2.0 to 3.5 on boxes, spheres and
+/// config/meshes/part.stl at 10 to 40 tetrahedra across, the regime of any mesh near the limit, so the
+/// estimate errs high. (A mesh a few tetrahedra across has more, up to 12: its surface's layer of
+/// smaller tetrahedra counts.)
 constexpr double kTetsPerMaxVolume = 3.5;
 
 /// Every mesh below is TetGen's quality mesh (-pq1.414a<v_max>): no tetrahedron larger than v_max =
 /// resolution^3 / (2 sqrt 2) [m^3], three regular tetrahedra of edge `resolution`, which makes the mean
-/// edge about `resolution` [m] (0.8 to 1.0 of it, measured). Tetrahedra with no node on the surface have
-/// a radius-edge ratio (circumradius over shortest edge) <= sqrt 2, as TetGen's Delaunay refinement
-/// guarantees, up to its node smoothing after refinement (within 2 %); at a curved surface the ratio
-/// can be larger (up to 1.7 measured on spheres), as TetGen splits the surface's triangles only so far.
+/// edge about `resolution` [m] (measured 0.8 to 1.25 of it at 10 or more tetrahedra across; 0.62 on a
+/// sphere 4 across, where the surface's smaller tetrahedra weigh more). TetGen's Delaunay refinement
+/// bounds the radius-edge ratio (circumradius over shortest edge) by sqrt 2; its optimisation after
+/// refinement (flips and smoothing, which remove slivers) moves that a little for the tetrahedra with no
+/// node on the surface (measured up to 1.45, 2.6 % over), and more for those at a curved surface (1.7 on
+/// spheres) or a concave edge (3.8 on part.stl), where TetGen splits the surface's triangles only so far.
 
 /// The box of full extents `size` [m] (x, y, z) about the origin. Its six faces are flat, so the
 /// tetrahedra fill it exactly. Throws DefinitionError (keys "size", "resolution") when a component of
