@@ -55,6 +55,9 @@ constexpr double kTetsPerMaxVolume = 3.5;
 /// refinement (flips and smoothing, which remove slivers) moves that a little for the tetrahedra with no
 /// node on the surface (measured up to 1.45, 2.6 % over), and more for those at a curved surface (1.7 on
 /// spheres) or a concave edge (3.8 on part.stl), where TetGen splits the surface's triangles only so far.
+/// Each throws std::runtime_error when the tetgen program is not on PATH (install the Debian package
+/// tetgen) or fails. Meshing takes seconds when fine (measured: 1 s for a sphere's 36,000 tetrahedra,
+/// 3.4 s for a box's 350,000), so a mesh near kMaxTetrahedra takes tens of seconds.
 
 /// The box of full extents `size` [m] (x, y, z) about the origin. Its six faces are flat, so the
 /// tetrahedra fill it exactly. Throws DefinitionError (keys "size", "resolution") when a component of
