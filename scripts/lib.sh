@@ -16,6 +16,7 @@ PACKAGES=(
   libroscpp-dev libtf2-ros-dev libtf2-geometry-msgs-dev ros-tf2-msgs
   python3-rostest librostest-dev python3-roslaunch python3-rostopic python3-rosbag
   libeigen3-dev libyaml-cpp-dev libopenvdb-dev libassimp-dev libroslib-dev
+  tetgen
   googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
