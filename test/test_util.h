@@ -11,6 +11,7 @@
 #include "soft_body_sim/core/rods.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/core/stability.h"
+#include "soft_body_sim/core/tetrahedra.h"
 
 namespace soft_body_sim::test
 {
@@ -45,6 +46,7 @@ inline std::vector<IntegratorType> stableIntegrators(const SceneDef& scene)
     try
     {
       requireRodIntegrator(model, with.physics.integrator);
+      requireVolumeIntegrator(model, with.physics.integrator);
     }
     catch (const std::invalid_argument&)
     {

@@ -130,6 +130,10 @@ void IntegratorGroups::rebuild(const Model& model)
     for (const Rod& rod : model.rods)
       if (mine(rod.first))
         m.rods.push_back(rod);
+    m.tetrahedra.clear();
+    for (const Tetrahedron& tet : model.tetrahedra)
+      if (mine(tet.nodes[0]))
+        m.tetrahedra.push_back(tet);
     m.colliders = Colliders{};
     m.contact_segments.clear();
     groups_.push_back(std::move(group));

@@ -10,6 +10,7 @@ MaterialScaling::MaterialScaling(const Model& built)
   , built_constraints_(built.constraints)
   , built_cells_(built.cells)
   , built_rods_(built.rods)
+  , built_tetrahedra_(built.tetrahedra)
   , scaling_(built.bodies.size())
   , has_material_(built.bodies.size(), 0)
 {
@@ -21,6 +22,8 @@ MaterialScaling::MaterialScaling(const Model& built)
     has_material_[built.bodyOf(cell.nodes[0])] = 1;
   for (const Rod& rod : built.rods)
     has_material_[built.bodyOf(rod.first)] = 1;
+  for (const Tetrahedron& tet : built.tetrahedra)
+    has_material_[built.bodyOf(tet.nodes[0])] = 1;
 }
 
 void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& scaling)
@@ -51,6 +54,13 @@ void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& sca
       model.rods[k].bending_stiffness = built_rods_[k].bending_stiffness * scaling.stiffness;
       model.rods[k].twisting_stiffness = built_rods_[k].twisting_stiffness * scaling.stiffness;
       model.rods[k].damping = built_rods_[k].damping * scaling.damping;
+    }
+  // A solid's Lame parameters scale with its Young's modulus (its Poisson's ratio kept).
+  for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
+    if (model.bodyOf(built_tetrahedra_[k].nodes[0]) == body)
+    {
+      model.tetrahedra[k].mu = built_tetrahedra_[k].mu * scaling.stiffness;
+      model.tetrahedra[k].lambda = built_tetrahedra_[k].lambda * scaling.stiffness;
     }
 }
 

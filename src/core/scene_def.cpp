@@ -10,6 +10,7 @@
 
 #include "soft_body_sim/core/forces.h"
 #include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/tetrahedra.h"
 
 namespace soft_body_sim
 {
@@ -187,6 +188,16 @@ World buildWorld(const SceneDef& scene)
                                     "last node is clamped or anchored (the holder takes any moment there)");
       model.rods.push_back(rod);
     }
+    for (Tetrahedron tet : body.tetrahedra)
+    {
+      for (int& node : tet.nodes)
+        node = globalIndex(body, first, node);
+      model.tetrahedra.push_back(tet);
+    }
+    std::vector<std::array<int, 3>> surface = body.surface;
+    for (std::array<int, 3>& triangle : surface)
+      for (int& node : triangle)
+        node = globalIndex(body, first, node);
     for (const auto& [a, b] : body.contact_segments)
       model.contact_segments.emplace_back(globalIndex(body, first, a), globalIndex(body, first, b));
     for (const AnchorDef& anchor : body.anchors)
@@ -199,12 +210,14 @@ World buildWorld(const SceneDef& scene)
       controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });
     requireSelfContact("body '" + body.name + "'", body.self_collision, body.self_friction, body.contact_radius,
                        "contact_radius");
-    model.bodies.push_back({ body.name, first, count, body.self_collision, body.self_friction, body.springs_collide });
+    model.bodies.push_back(
+        { body.name, first, count, body.self_collision, body.self_friction, body.springs_collide, std::move(surface) });
     first += count;
   }
   try
   {
     requireRodIntegrator(model, scene.physics.integrator);
+    requireVolumeIntegrator(model, scene.physics.integrator);
   }
   catch (const std::invalid_argument& e)
   {

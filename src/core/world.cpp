@@ -8,6 +8,7 @@
 
 #include "soft_body_sim/core/forces.h"
 #include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/tetrahedra.h"
 
 namespace soft_body_sim
 {
@@ -173,6 +174,7 @@ std::string World::treatDiverged(std::size_t body)
 void World::setIntegrator(IntegratorType type)
 {
   requireRodIntegrator(model_, type);
+  requireVolumeIntegrator(model_, type);
   integrators_.setAll(type);
 }
 
@@ -311,6 +313,7 @@ NodeArray World::pulls() const
   internalPulls(model_, state_.position, internalForces(), pull);
   for (const Rod& rod : model_.rods)
     accumulateRodForces(rod, state_.position, state_.twist, pull);
+  accumulateTetForces(model_, state_.position, pull);
   return pull;
 }
 

@@ -13,7 +13,7 @@ namespace soft_body_sim
 /// Live multipliers of one body's material, relative to the scene's values. 1 = as loaded; each > 0.
 struct BodyScaling
 {
-  double stiffness = 1.0;  ///< [-] spring stiffness k, constraint stiffness 1 / compliance, a rod's E I and G J
+  double stiffness = 1.0;  ///< [-] spring stiffness k, constraint stiffness 1 / compliance, a rod's E I and G J, a solid's E
   double damping = 1.0;    ///< [-] spring dashpots c, a rod's damping beta
   double pressure = 1.0;   ///< [-] rest gas pressure p0 of the body's cells
 };
@@ -37,6 +37,7 @@ private:
   std::vector<DistanceConstraint> built_constraints_;
   std::vector<PressureCell> built_cells_;
   std::vector<Rod> built_rods_;
+  std::vector<Tetrahedron> built_tetrahedra_;
   std::vector<BodyScaling> scaling_;  ///< per body
   std::vector<char> has_material_;    ///< per body
 };

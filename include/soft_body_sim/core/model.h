@@ -2,6 +2,7 @@
 // Header of the ROS-free core: Eigen and the standard library only.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <stdexcept>
 #include <string>
@@ -101,6 +102,18 @@ struct Rod
   double restLength() const { return segment_length * (count - 1); }
 };
 
+/// A tetrahedron of a soft solid (a `type: volume` body; tetrahedra.h): four nodes, positively oriented at
+/// rest, of a stable neo-Hookean material (Smith, de Goes and Kim 2018) with Lame parameters mu and lambda:
+/// energy rest_volume Psi(F), F = D_s rest_inverse the deformation gradient, D_s = [x1 - x0, x2 - x0, x3 - x0].
+struct Tetrahedron
+{
+  int nodes[4] = { 0, 0, 0, 0 };
+  Eigen::Matrix3d rest_inverse = Eigen::Matrix3d::Identity();  ///< D_m^-1: D_s's inverse at rest [1/m]
+  double rest_volume = 0.0;  ///< V0 = det(D_m) / 6 [m^3], > 0
+  double mu = 0.0;           ///< Lame's second parameter, the shear modulus E / (2 (1 + nu)) [Pa], > 0
+  double lambda = 0.0;       ///< Lame's first parameter E nu / ((1 + nu)(1 - 2 nu)) [Pa], >= 0
+};
+
 /// A named run of consecutive nodes: the scene's bodies share one node array.
 struct BodyRange
 {
@@ -110,6 +123,9 @@ struct BodyRange
   bool self_collision = false;  ///< its links keep apart by their radii (self_contacts.h)
   double self_friction = 0.0;   ///< Coulomb coefficient [-] where they touch (self_contacts.h)
   bool springs_collide = false; ///< its springs too keep its own nodes out (a jelly; self_contacts.h)
+  /// A solid's boundary (a `type: volume` body): triangles of global node indices, counter-clockwise seen
+  /// from outside; empty for every other body.
+  std::vector<std::array<int, 3>> surface;
 };
 
 /// A named node of a body that the caller moves kinematically (its node is pinned).
@@ -138,6 +154,7 @@ struct Model
   std::vector<DistanceConstraint> constraints;
   std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then
   std::vector<Rod> rods;            ///< empty unless a scene has rods: no bending or twist pass then
+  std::vector<Tetrahedron> tetrahedra;  ///< empty unless a scene has volumes: no elasticity pass then
   std::vector<BodyRange> bodies;
   Colliders colliders;  ///< as the scene declares them; the contact stage prepares its own copies
   std::vector<Anchor> anchors;

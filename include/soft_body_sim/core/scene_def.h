@@ -94,6 +94,12 @@ struct BodyDef
   /// A rod's bending and twisting over all its nodes in order (a `type: rod` body, bodies/rod.h), its
   /// first node 0 of the body; empty for every other body.
   std::optional<Rod> rod;
+  /// A solid's tetrahedra (a `type: volume` body, bodies/volume.h), their nodes indices within the body;
+  /// empty for every other body.
+  std::vector<Tetrahedron> tetrahedra;
+  /// A solid's boundary triangles, node indices within the body, counter-clockwise seen from outside
+  /// (BodyRange::surface).
+  std::vector<std::array<int, 3>> surface;
 };
 
 /// The checks of a body type's self-contact keys (rope, cloth, jelly), for its builder: self_friction

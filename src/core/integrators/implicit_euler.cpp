@@ -12,6 +12,7 @@
 #include "sparse_block_solver.h"
 #include "soft_body_sim/core/forces.h"
 #include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/tetrahedra.h"
 
 namespace soft_body_sim
 {
@@ -45,8 +46,11 @@ using Matrix3 = Eigen::Matrix3d;
 /// it is of order M_t l / (E I) for a twisting moment M_t, l / L near the critical twist of a long rod.
 /// A rod's end moment (a couple on its last segment) enters f only, explicitly too: its stiffness M / l^2
 /// is 2 pi l / L of the bending's E I / l^3 even at a full circle's moment 2 pi E I / L.
+/// Tetrahedra (tetrahedra.h) enter f with their elastic forces and K with their stiffness projected onto
+/// the positive semi-definite matrices per tetrahedron (tetForcesAndStiffness), so that A stays symmetric
+/// positive definite through any strain and inversion.
 /// A spring's 3x3 block is a u u^T + b I (below), a cell's h^2 S g_k g_l^T, a rod vertex's
-/// (h^2 + h beta) 2 w J_k^T J_l. The matrix's pattern (which
+/// (h^2 + h beta) 2 w J_k^T J_l, a tetrahedron's h^2 K_ab. The matrix's pattern (which
 /// node pairs couple) depends only on the springs, the cells and which nodes are pinned: it is analysed
 /// on the first step and after every model change, and each Newton iteration only writes its values and
 /// factorises. Every array is sized once: a step allocates nothing after the first.
@@ -119,6 +123,13 @@ private:
     int nodes[3];
     Matrix3 jacobian[3];
     double scale;  ///< (h^2 + h beta) 2 w [N m^3 s^2]
+  };
+
+  /// A tetrahedron's blocks h^2 K_ab (TetStiffness's order) and its nodes (-1 where pinned).
+  struct TetBlock
+  {
+    int nodes[4];
+    TetStiffness scaled;
   };
 
   /// Fills the blocks of A = M - h D - h^2 K and rhs_ (see the class comment) at (x, v), the rods' twists
@@ -214,6 +225,45 @@ private:
       addCell(model, model.cells[k], x, h, cells_[k]);
     if (!model.rods.empty())
       addRods(model, x, v, twist, h);
+    if (!model.tetrahedra.empty())
+      addTetrahedra(model, x, h);
+  }
+
+  /// The tetrahedra's blocks (their diagonal ones into diagonal_) and h (f + K offset) in rhs_ (K = -df/dx).
+  /// The condition estimate takes each node's block of one tetrahedron as a spring's (see condition_).
+  void addTetrahedra(const Model& model, const NodeArray& x, double h)
+  {
+    tet_blocks_.resize(model.tetrahedra.size());
+    Eigen::Matrix<double, 3, 4> force;
+    for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
+    {
+      const Tetrahedron& tet = model.tetrahedra[k];
+      TetBlock& block = tet_blocks_[k];
+      tetForcesAndStiffness(tet, x, true, force, block.scaled);
+      for (int a = 0; a < 4; ++a)
+        block.nodes[a] = model.isFree(tet.nodes[a]) ? tet.nodes[a] : -1;
+      // rhs_a += h f_a - h sum_b K_ab offset_b, over the free b (a pinned node's offset is 0).
+      for (int a = 0; a < 4; ++a)
+        if (block.nodes[a] >= 0)
+          rhs_.col(block.nodes[a]) += h * (force.col(a) - block.scaled.blocks[a] * offset_.col(block.nodes[a]));
+      for (std::size_t p = 0; p < kTetPairs.size(); ++p)
+      {
+        const int a = kTetPairs[p].first, b = kTetPairs[p].second;
+        const Matrix3& k_ab = block.scaled.blocks[4 + p];
+        if (block.nodes[a] >= 0)
+          rhs_.col(block.nodes[a]) -= h * (k_ab * offset_.col(tet.nodes[b]));
+        if (block.nodes[b] >= 0)
+          rhs_.col(block.nodes[b]) -= h * (k_ab.transpose() * offset_.col(tet.nodes[a]));
+      }
+      for (Matrix3& k_ab : block.scaled.blocks)
+        k_ab *= h * h;
+      for (int a = 0; a < 4; ++a)
+        if (block.nodes[a] >= 0)
+        {
+          diagonal_[static_cast<std::size_t>(block.nodes[a])] += block.scaled.blocks[a];
+          condition_ = std::max(condition_, 1.0 + 4.0 * block.scaled.blocks[a].trace() * model.inverse_mass[tet.nodes[a]]);
+        }
+    }
   }
 
   /// The rods' bending blocks (on the diagonal here; off it in multiply and solveDirectly) and their
@@ -349,6 +399,16 @@ private:
             j_p += block.jacobian[l] * p.col(block.nodes[l]);
         out.col(block.nodes[c]) += block.scale * (block.jacobian[c].transpose() * j_p);
       }
+    for (const TetBlock& block : tet_blocks_)
+      for (std::size_t pair = 0; pair < kTetPairs.size(); ++pair)
+      {
+        const int a = block.nodes[kTetPairs[pair].first], b = block.nodes[kTetPairs[pair].second];
+        if (a < 0 || b < 0)
+          continue;
+        const Matrix3& k_ab = block.scaled.blocks[4 + pair];
+        out.col(a) += k_ab * p.col(b);
+        out.col(b) += k_ab.transpose() * p.col(a);
+      }
   }
 
   void precondition(const NodeArray& r, NodeArray& z) const
@@ -449,6 +509,17 @@ private:
         }
       }
     }
+    tet_slot_.assign(6 * model.tetrahedra.size(), -1);
+    for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
+      for (std::size_t p = 0; p < kTetPairs.size(); ++p)
+      {
+        const int a = model.tetrahedra[k].nodes[kTetPairs[p].first], b = model.tetrahedra[k].nodes[kTetPairs[p].second];
+        if (model.isFree(a) && model.isFree(b))
+        {
+          tet_slot_[6 * k + p] = static_cast<int>(pairs.size());
+          pairs.emplace_back(a, b);
+        }
+      }
     chains_ = linear_solve_ != LinearSolve::Iterative && chain_solver_.analyze(model.nodeCount(), pairs);
     factorable_ = chains_ || (linear_solve_ != LinearSolve::Iterative &&
                               solver_.analyze(model.nodeCount(), pairs,
@@ -515,6 +586,10 @@ private:
                                 block.scale * block.jacobian[kRodPairs[p].first].transpose() *
                                     block.jacobian[kRodPairs[p].second]);
     }
+    for (std::size_t k = 0; k < tet_blocks_.size(); ++k)
+      for (std::size_t p = 0; p < kTetPairs.size(); ++p)
+        if (tet_slot_[6 * k + p] >= 0)
+          solver.addOffDiagonal(static_cast<std::size_t>(tet_slot_[6 * k + p]), tet_blocks_[k].scaled.blocks[4 + p]);
     // A is symmetric positive definite by construction (the transverse stiffness of compressed springs
     // and the indefinite part of the gas's Hessian are dropped, see above), unless the state is not
     // finite: then the step is not finite either, and the divergence guard (guard.h) takes it.
@@ -571,6 +646,8 @@ private:
   std::vector<int> rod_of_vertex_;       ///< per rod vertex: its rod's index in Model::rods
   std::vector<RodBlock> rod_blocks_;     ///< per rod vertex
   std::vector<int> rod_slot_;            ///< per rod vertex, three: each node pair's slot, or -1
+  std::vector<TetBlock> tet_blocks_;     ///< per tetrahedron
+  std::vector<int> tet_slot_;            ///< per tetrahedron, six: each node pair's slot, or -1
 };
 }  // namespace
 
