@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/mesh_field.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "yaml_reader.h"
 
@@ -83,6 +84,16 @@ BodyDef buildBody(const Context& ctx, const Field& field, const Def& def, Build 
   }
 }
 
+/// A mesh file named by the URI at `uri` (package://, file://, or a path relative to the scene file's
+/// folder), read at `scale` (readTriangleMesh): a mesh collider's or a volume's surface. A URI that does
+/// not resolve or a file that cannot be read fails at `uri` with the path and the reason.
+struct MeshFile
+{
+  std::string path;        ///< where the file is on disk
+  TriangleMesh triangles;  ///< [m]
+};
+MeshFile readMeshFile(const Context& ctx, const Field& uri, const Vec3& scale);
+
 using BodyReader = BodyDef (*)(const Context& ctx, const Field& body, const SceneSoFar& scene);
 
 struct BodyType
@@ -102,6 +113,7 @@ BodyDef readRopeBody(const Context& ctx, const Field& body, const SceneSoFar& sc
 BodyDef readRodBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 BodyDef readClothBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 BodyDef readJellyBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
+BodyDef readVolumeBody(const Context& ctx, const Field& body, const SceneSoFar& scene);
 
 // Procedurally animated body types (creature, limb, humanoid).
 BodyDef readCreatureBody(const Context& ctx, const Field& body, const SceneSoFar& scene);

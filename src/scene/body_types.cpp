@@ -10,6 +10,7 @@ const std::vector<BodyType>& bodyTypes()
     { "rod", readRodBody },
     { "cloth", readClothBody },
     { "jelly", readJellyBody },
+    { "volume", readVolumeBody },
     { "creature", readCreatureBody },
     { "limb", readLimbBody },
     { "humanoid", readHumanoidBody },

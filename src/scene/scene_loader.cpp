@@ -180,8 +180,7 @@ Shape readRadiusAndLength(const Context& ctx, const Field& field)
   return shape;
 }
 
-/// A mesh: its file resolved (package://, file://, or a path relative to the scene file's folder) and read
-/// with its scale; a file that cannot be read fails at `mesh` with the path and the reason.
+/// A mesh: its file read with its scale (readMeshFile).
 Mesh readMesh(const Context& ctx, const Field& field)
 {
   requireMap(ctx, field, withPlacementKeys({ "mesh", "scale", "voxel_size" }));
@@ -195,26 +194,9 @@ Mesh readMesh(const Context& ctx, const Field& field)
     mesh.voxel_size = readPositive(ctx, *value);
   if (!(mesh.scale.minCoeff() > 0.0))
     return mesh;  // checkCollider says so at `scale`; the file is not read at a scale that makes no solid
-  const std::size_t slash = ctx.source().rfind('/');
-  const std::string folder = slash == std::string::npos ? std::string() : ctx.source().substr(0, slash);
-  std::string path;
-  try
-  {
-    path = resolveMeshUri(mesh.uri, folder);
-  }
-  catch (const std::invalid_argument& e)
-  {
-    ctx.fail(uri, e.what());
-  }
-  try
-  {
-    mesh.triangles = std::make_shared<const TriangleMesh>(readTriangleMesh(path, mesh.scale));
-  }
-  catch (const DefinitionError& e)
-  {
-    ctx.fail(uri, e.what());
-  }
-  mesh.uri = drawableMeshUri(mesh.uri, path);
+  MeshFile file = readMeshFile(ctx, uri, mesh.scale);
+  mesh.triangles = std::make_shared<const TriangleMesh>(std::move(file.triangles));
+  mesh.uri = drawableMeshUri(mesh.uri, file.path);
   return mesh;
 }
 
@@ -377,6 +359,34 @@ SceneDef readScene(const Context& ctx, const Field& root)
 }
 
 }  // namespace
+
+namespace scene_yaml
+{
+MeshFile readMeshFile(const Context& ctx, const Field& uri, const Vec3& scale)
+{
+  const std::size_t slash = ctx.source().rfind('/');
+  const std::string folder = slash == std::string::npos ? std::string() : ctx.source().substr(0, slash);
+  const std::string text = readNonEmptyString(ctx, uri);
+  MeshFile file;
+  try
+  {
+    file.path = resolveMeshUri(text, folder);
+  }
+  catch (const std::invalid_argument& e)
+  {
+    ctx.fail(uri, e.what());
+  }
+  try
+  {
+    file.triangles = readTriangleMesh(file.path, scale);
+  }
+  catch (const DefinitionError& e)
+  {
+    ctx.fail(uri, e.what());
+  }
+  return file;
+}
+}  // namespace scene_yaml
 
 SceneDef loadSceneFile(const std::string& path)
 {

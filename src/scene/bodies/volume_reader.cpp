@@ -1,0 +1,73 @@
+// `type: volume`: a soft solid, a box, a ball or a closed surface file filled with tetrahedra
+// (bodies/volume.h).
+#include "../body_readers.h"
+#include "soft_body_sim/core/bodies/volume.h"
+
+namespace soft_body_sim::scene_yaml
+{
+namespace
+{
+VolumeShape readVolumeShape(const Context& ctx, const Field& field)
+{
+  const std::string name = readNonEmptyString(ctx, field);
+  if (name == "box")
+    return VolumeShape::Box;
+  if (name == "sphere")
+    return VolumeShape::Sphere;
+  if (name == "mesh")
+    return VolumeShape::Mesh;
+  ctx.fail(field, "unknown shape " + quoted(name) + "; valid shapes: box, sphere, mesh");
+}
+
+/// `pinned: [...]`: box face names and node indices, as written (the builder checks both: the node count
+/// is known only once the body is meshed).
+void readPinnedNodesAndFaces(const Context& ctx, const Field& field, VolumeDef& volume)
+{
+  for (const Field& item : requireList(ctx, field))
+  {
+    if (!item.node.IsScalar())
+      ctx.fail(item, "expected a node index or a face name, got " + describe(item.node));
+    const std::string& text = item.node.Scalar();
+    if (!text.empty() && std::string("+-0123456789").find(text[0]) != std::string::npos)
+      volume.pinned_nodes.push_back(readInt(ctx, item));
+    else
+      volume.pinned_faces.push_back(readNonEmptyString(ctx, item));
+  }
+}
+}  // namespace
+
+BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
+{
+  requireMap(ctx, field, withCommonBodyKeys({ "shape", "size", "radius", "mesh", "resolution", "position",
+                                              "youngs_modulus", "poisson_ratio", "density", "pinned", "pressure" }));
+  VolumeDef volume;
+  volume.shape = readVolumeShape(ctx, requiredKey(ctx, field, "shape"));
+  if (const std::optional<Field> value = optionalKey(field, "size"))
+    volume.size = readVec3(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "radius"))
+    volume.radius = readNumber(ctx, *value);
+  if (const std::optional<Field> value = optionalKey(field, "mesh"))
+  {
+    volume.mesh = readNonEmptyString(ctx, *value);
+    if (volume.shape == VolumeShape::Mesh)  // on another shape the builder says the key does not belong
+      volume.surface = readMeshFile(ctx, *value, Vec3::Ones()).triangles;
+  }
+  const Field resolution = requiredKey(ctx, field, "resolution");
+  volume.resolution = readNumber(ctx, resolution);
+  volume.position = readVec3(ctx, requiredKey(ctx, field, "position"));
+  volume.youngs_modulus = readNumber(ctx, requiredKey(ctx, field, "youngs_modulus"));
+  if (const std::optional<Field> value = optionalKey(field, "poisson_ratio"))
+    volume.poisson_ratio = readNumber(ctx, *value);
+  volume.density = readNumber(ctx, requiredKey(ctx, field, "density"));
+  if (const std::optional<Field> value = optionalKey(field, "pinned"))
+    readPinnedNodesAndFaces(ctx, *value, volume);
+  if (const std::optional<Field> value = optionalKey(field, "pressure"))
+    volume.pressure = readNumber(ctx, *value);
+  BodyDef body = buildBody(ctx, field, volume, buildVolume);
+  // The node count is known only after meshing; the mesher's own limit (kMaxTetrahedra) bounds the memory
+  // that takes, so the scene's limit is checked here, at the key that sets the count.
+  scene.requireNodes(ctx, resolution, static_cast<long long>(body.nodes.size()));
+  return body;
+}
+
+}  // namespace soft_body_sim::scene_yaml
