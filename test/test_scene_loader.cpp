@@ -7,6 +7,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -919,7 +920,7 @@ TEST(SceneLoader, HugeBodiesAreRefusedBeforeTheyExhaustMemory)
 }
 
 /// A body that would take the scene over its limit of 10^6 nodes after a rope of 999,998 nodes: each type
-/// counts its nodes before building them.
+/// counts its nodes before building them (a volume once meshed: only then is its node count known).
 struct OverBudget
 {
   const char* name;
@@ -945,6 +946,9 @@ const OverBudget kOverBudget[] = {
   { "Rod", "{name: b, type: rod, nodes: 3, from: [0, 0, 0], to: [1, 0, 0], radius: 0.01, youngs_modulus: 1e9, "
           "density: 1000}",
     "bad.yaml:3: bodies[1].nodes" },
+  { "Volume", "{name: b, type: volume, shape: box, size: [0.04, 0.04, 0.04], resolution: 0.02, "
+             "position: [0, 0, 1], youngs_modulus: 5e4, density: 100}",
+    "bad.yaml:3: bodies[1].resolution" },
   { "Creature", "{name: b, type: creature}", "bad.yaml:3: bodies[1]" },
   { "CreatureTendrils", "{name: b, type: creature, tendrils: {segments: 1}}",
     "bad.yaml:3: bodies[1].tendrils.segments" },
@@ -1451,6 +1455,224 @@ TEST(SceneLoader, ARodsMistakesAreNamedAtTheirKeys)
   World world = buildWorld(parseScene("physics: {integrator: implicit_euler}\nbodies:\n  - " + rod + "}\n", "ok.yaml"));
   EXPECT_THROW(world.setIntegrator(IntegratorType::Rk4), std::invalid_argument);
   EXPECT_EQ(world.integrator(), IntegratorType::ImplicitEuler);
+}
+
+// --- type: volume ----------------------------------------------------------------------------------
+
+/// The area [m^2] of a body's boundary triangles.
+double surfaceArea(const BodyDef& body)
+{
+  double area = 0.0;
+  for (const std::array<int, 3>& f : body.surface)
+  {
+    const Vec3& a = body.nodes[f[0]].position;
+    area += 0.5 * (body.nodes[f[1]].position - a).cross(body.nodes[f[2]].position - a).norm();
+  }
+  return area;
+}
+
+/// The volume [m^3] a body's boundary encloses by the divergence theorem, sum a . (b x c) / 6 over its
+/// triangles (independent of its tetrahedra), about the point `origin` to keep the round-off small.
+double enclosedVolume(const BodyDef& body, const Vec3& origin)
+{
+  double volume = 0.0;
+  for (const std::array<int, 3>& f : body.surface)
+    volume += (body.nodes[f[0]].position - origin)
+                  .dot((body.nodes[f[1]].position - origin).cross(body.nodes[f[2]].position - origin)) /
+              6.0;
+  return volume;
+}
+
+double totalMass(const BodyDef& body)
+{
+  double mass = 0.0;
+  for (const NodeDef& node : body.nodes)
+    mass += node.mass;
+  return mass;
+}
+
+TEST(SceneLoader, ABoxVolumeIsFilledWithTetrahedraOfItsMaterial)
+{
+  const SceneDef scene = parseScene(R"(physics: {integrator: implicit_euler}
+bodies:
+  - name: sponge
+    type: volume
+    shape: box
+    size: [0.1, 0.08, 0.05]
+    resolution: 0.02
+    position: [0.3, -0.2, 0.5]
+    youngs_modulus: 5.0e4
+    poisson_ratio: 0.3
+    density: 100.0
+    pinned: [z_max]
+    pressure: 0.0
+    anchors: [{name: corner, node: -1}]
+)",
+                                     "sponge.yaml");
+  ASSERT_EQ(scene.bodies.size(), 1u);
+  const BodyDef& body = scene.bodies[0];
+  EXPECT_EQ(body.type, "volume");
+  EXPECT_EQ(body.contact_radius, 0.0);
+  const double a = 0.1, b = 0.08, c = 0.05, volume = a * b * c;
+  // The box's mass, its volume filled exactly by positive tetrahedra, and its six faces' area.
+  EXPECT_NEAR(totalMass(body), 100.0 * volume, 1e-9 * 100.0 * volume);
+  ASSERT_FALSE(body.tetrahedra.empty());
+  double filled = 0.0;
+  for (const Tetrahedron& tet : body.tetrahedra)
+  {
+    EXPECT_GT(tet.rest_volume, 0.0);
+    filled += tet.rest_volume;
+    // Lame's parameters of E = 5e4 Pa, nu = 0.3 by hand.
+    EXPECT_NEAR(tet.mu, 5.0e4 / 2.6, 1e-9);
+    EXPECT_NEAR(tet.lambda, 5.0e4 * 0.3 / (1.3 * 0.4), 1e-9);
+  }
+  EXPECT_NEAR(filled, volume, 1e-9 * volume);
+  EXPECT_NEAR(surfaceArea(body), 2.0 * (a * b + b * c + c * a), 1e-9 * 2.0 * (a * b + b * c + c * a));
+  EXPECT_NEAR(enclosedVolume(body, Vec3(0.3, -0.2, 0.5)), volume, 1e-9 * volume);
+  // z_max: the nodes of the boundary triangles that face up (normal +z) are pinned, and no other; the
+  // box's four top corners among them.
+  std::vector<bool> on_top(body.nodes.size(), false);
+  for (const std::array<int, 3>& f : body.surface)
+  {
+    const Vec3 normal = (body.nodes[f[1]].position - body.nodes[f[0]].position)
+                            .cross(body.nodes[f[2]].position - body.nodes[f[0]].position)
+                            .normalized();
+    if (normal.z() > 1.0 - 1e-9)
+      for (int k : f)
+        on_top[static_cast<std::size_t>(k)] = true;
+  }
+  int pinned = 0, corners = 0;
+  for (std::size_t k = 0; k < body.nodes.size(); ++k)
+  {
+    EXPECT_EQ(body.nodes[k].pinned, on_top[k]) << "node " << k << " at " << body.nodes[k].position.transpose();
+    pinned += body.nodes[k].pinned;
+    const Vec3 offset = body.nodes[k].position - Vec3(0.3, -0.2, 0.5);
+    corners += body.nodes[k].pinned && std::abs(std::abs(offset.x()) - a / 2) < 1e-12 &&
+               std::abs(std::abs(offset.y()) - b / 2) < 1e-12 && std::abs(offset.z() - c / 2) < 1e-12;
+  }
+  EXPECT_EQ(corners, 4);
+  EXPECT_GE(pinned, 4);
+  EXPECT_LT(pinned, static_cast<int>(body.nodes.size()));
+  // In the world: its tetrahedra and boundary, pinned nodes of inverse mass 0, its anchor on the last node.
+  const World world = buildWorld(scene);
+  EXPECT_EQ(world.model().tetrahedra.size(), body.tetrahedra.size());
+  EXPECT_EQ(world.model().bodies[0].surface.size(), body.surface.size());
+  for (std::size_t k = 0; k < body.nodes.size(); ++k)
+  {
+    if (on_top[k])
+    {
+      EXPECT_EQ(world.model().inverse_mass[static_cast<Eigen::Index>(k)], 0.0) << "node " << k;
+    }
+  }
+  ASSERT_EQ(world.model().anchors.size(), 1u);
+  EXPECT_EQ(world.model().anchors[0].node, static_cast<int>(body.nodes.size()) - 1);
+}
+
+TEST(SceneLoader, ASphereVolumeWeighsItsDensityTimesItsMeshVolume)
+{
+  const SceneDef scene = parseScene(R"(physics: {integrator: implicit_euler}
+bodies:
+  - {name: ball, type: volume, shape: sphere, radius: 0.05, resolution: 0.02, position: [0, 0, 1],
+     youngs_modulus: 1.0e5, density: 250.0}
+)",
+                                     "ball.yaml");
+  const BodyDef& body = scene.bodies[0];
+  // The mesh's volume by the divergence theorem over its boundary, and within the bounds of volume_mesh.h's
+  // inscribed polyhedron: below the ball's 4/3 pi r^3 by at most 0.51 (resolution / r)^2 of it.
+  const double mesh_volume = enclosedVolume(body, Vec3(0.0, 0.0, 1.0)), ball = 4.0 / 3.0 * M_PI * std::pow(0.05, 3);
+  EXPECT_LT(mesh_volume, ball);
+  EXPECT_GT(mesh_volume, (1.0 - 0.51 * std::pow(0.02 / 0.05, 2)) * ball);
+  EXPECT_NEAR(totalMass(body), 250.0 * mesh_volume, 1e-9 * 250.0 * mesh_volume);
+  for (const NodeDef& node : body.nodes)
+  {
+    EXPECT_FALSE(node.pinned);
+    EXPECT_LE((node.position - Vec3(0.0, 0.0, 1.0)).norm(), 0.05 * (1.0 + 1e-12));
+  }
+  EXPECT_EQ(buildWorld(scene).model().tetrahedra.size(), body.tetrahedra.size());
+}
+
+TEST(SceneLoader, AMeshVolumeFillsItsSurfaceFile)
+{
+  // The example bracket (scripts/make_part_stl.py): an L-shaped profile of area 0.1 x 0.02 + 0.02 x 0.06
+  // [m^2] extruded 0.06 m, stored in single precision.
+  const std::string part = std::string("file://") + SOURCE_DIR + "/config/meshes/part.stl";
+  const SceneDef scene = parseScene("physics: {integrator: implicit_euler}\nbodies:\n"
+                                    "  - {name: part, type: volume, shape: mesh, mesh: " + part +
+                                        ", resolution: 0.01, position: [1, 0, 0], youngs_modulus: 1.0e6, "
+                                        "poisson_ratio: 0.45, density: 1000.0, pinned: [0, -1]}\n",
+                                    "part.yaml");
+  const BodyDef& body = scene.bodies[0];
+  const double volume = (0.1 * 0.02 + 0.02 * 0.06) * 0.06;
+  EXPECT_NEAR(totalMass(body), 1000.0 * volume, 1e-6 * 1000.0 * volume);
+  EXPECT_TRUE(body.nodes.front().pinned);
+  EXPECT_TRUE(body.nodes.back().pinned);
+  EXPECT_EQ(buildWorld(scene).model().tetrahedra.size(), body.tetrahedra.size());
+}
+
+TEST(SceneLoader, AVolumesMistakesAreNamedAtTheirKeys)
+{
+  const std::string box = "{name: s, type: volume, resolution: 0.02, position: [0, 0, 1], youngs_modulus: 5e4, "
+                          "density: 100, shape: box, size: [0.04, 0.04, 0.04]";
+  const std::string ball = "{name: s, type: volume, resolution: 0.02, position: [0, 0, 1], youngs_modulus: 5e4, "
+                           "density: 100, shape: sphere, radius: 0.03";
+  expectSceneError("bodies:\n  - " + box + ", poisson_ratio: 0.5}\n", "bad.yaml:2: bodies[0].poisson_ratio",
+                   { "[0, 0.5)" });
+  expectSceneError("bodies:\n  - {name: s, type: volume, resolution: 0.02, position: [0, 0, 1], youngs_modulus: 0, "
+                   "density: 100, shape: box, size: [0.04, 0.04, 0.04]}\n",
+                   "bad.yaml:2: bodies[0].youngs_modulus", { "> 0" });
+  expectSceneError("bodies:\n  - {name: s, type: volume, shape: cube}\n", "bad.yaml:2: bodies[0].shape",
+                   { "unknown shape 'cube'", "box, sphere, mesh" });
+  expectSceneError("bodies:\n  - " + ball + ", size: [0.1, 0.1, 0.1]}\n", "bad.yaml:2: bodies[0].size",
+                   { "only for shape box" });
+  expectSceneError("bodies:\n  - " + ball + ", pinned: [z_max]}\n", "bad.yaml:2: bodies[0].pinned",
+                   { "z_max", "only for shape box" });
+  expectSceneError("bodies:\n  - " + box + ", pinned: [top]}\n", "bad.yaml:2: bodies[0].pinned",
+                   { "unknown face 'top'", "x_min, x_max, y_min, y_max, z_min, z_max" });
+  expectSceneError("bodies:\n  - " + box + ", pinned: [100000]}\n", "bad.yaml:2: bodies[0].pinned",
+                   { "out of range" });
+  expectSceneError("bodies:\n  - " + box + ", pressure: 1000}\n", "bad.yaml:2: bodies[0].pressure",
+                   { "not supported yet" });
+  expectSceneError("bodies:\n  - {name: s, type: volume, resolution: 0.02, position: [0, 0, 1], "
+                   "youngs_modulus: 5e4, density: 100, shape: box}\n",
+                   "bad.yaml:2: bodies[0].shape", { "needs size" });
+  // Only implicit_euler runs a volume's elasticity: another integrator is refused, not silently a cloud of
+  // free nodes.
+  try
+  {
+    buildWorld(parseScene("physics: {integrator: semi_implicit_euler}\nbodies:\n  - " + box + "}\n", "bad.yaml"));
+    ADD_FAILURE() << "built a volume under semi_implicit_euler";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    EXPECT_NE(std::string(e.what()).find("implicit_euler"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SceneLoader, AVolumeOfAnOpenSurfaceIsRefusedAtItsMesh)
+{
+  // A cube of 5 cm as an ASCII STL with its last triangle missing: three edges in one triangle only.
+  const std::string path = (std::filesystem::temp_directory_path() / "soft_body_sim_open_cube.stl").string();
+  {
+    const int quads[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 } };
+    const auto corner = [](int k) {
+      return Vec3(k & 1 ? 0.025 : -0.025, k & 2 ? 0.025 : -0.025, k & 4 ? 0.025 : -0.025);
+    };
+    std::ofstream file(path);
+    file << "solid open\n";
+    for (int q = 0; q < 6; ++q)
+      for (int half = 0; half < (q == 5 ? 1 : 2); ++half)
+      {
+        file << " facet normal 0 0 0\n  outer loop\n";
+        for (int k : { quads[q][0], quads[q][1 + half], quads[q][2 + half] })
+          file << "   vertex " << corner(k).x() << " " << corner(k).y() << " " << corner(k).z() << "\n";
+        file << "  endloop\n endfacet\n";
+      }
+    file << "endsolid open\n";
+  }
+  expectSceneError("bodies:\n  - {name: s, type: volume, shape: mesh, mesh: " + path +
+                       ", resolution: 0.02, position: [0, 0, 1], youngs_modulus: 5e4, density: 100}\n",
+                   "bad.yaml:2: bodies[0].mesh", { "not closed", path });
+  std::remove(path.c_str());
 }
 
 TEST(SceneLoader, DirectoryCannotBeOpened)
