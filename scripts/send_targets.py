@@ -20,6 +20,8 @@ Parameters (private, all optional):
   ~gripper_center [m] centre of its motion (default [-7.25, 0.0, 1.25])
   ~gripper_height [m] it rises this far above the centre and as far below (default 0.35)
   ~gripper_period [s] one up and down (default 6)
+  ~gripper_phase  [s] it moves as if started this far into its period (default 0: at its lowest point;
+                  half the period starts it at its highest, as launch/soft_box.launch's press does)
   ~frame_id       frame of every path (default world)
   ~rate           [Hz] poses per second on each topic (default 20)
   ~lead           [s] each pose is stamped this far ahead of now, so that it reaches the simulator
@@ -86,6 +88,7 @@ def main():
     gripper_center = rospy.get_param("~gripper_center", [-7.25, 0.0, 1.25])
     gripper_height = rospy.get_param("~gripper_height", 0.35)
     gripper_period = rospy.get_param("~gripper_period", 6.0)
+    gripper_phase = rospy.get_param("~gripper_phase", 0.0)
 
     target_pub = rospy.Publisher(target_topic, PoseStamped, queue_size=10) if target_topic else None
     anchor_pub = rospy.Publisher(anchor_topic, PoseStamped, queue_size=10) if anchor_topic else None
@@ -103,7 +106,8 @@ def main():
             anchor_pub.publish(pose(frame_id, stamp, *circle(anchor_center, anchor_radius, anchor_period, t)))
         if broadcaster:
             broadcaster.sendTransform(transform(frame_id, gripper_frame, stamp,
-                                                *up_and_down(gripper_center, gripper_height, gripper_period, t)))
+                                                *up_and_down(gripper_center, gripper_height, gripper_period,
+                                                            t + gripper_phase)))
         try:
             ticker.sleep()
         except rospy.ROSInterruptException:
