@@ -84,14 +84,15 @@ BodyDef buildBody(const Context& ctx, const Field& field, const Def& def, Build 
   }
 }
 
-/// A mesh file named by the URI at `uri` (package://, file://, or a path relative to the scene file's
-/// folder), read at `scale` (readTriangleMesh): a mesh collider's or a volume's surface. A URI that does
-/// not resolve or a file that cannot be read fails at `uri` with the path and the reason.
+/// A mesh file as read: a mesh collider's shape or a volume's surface.
 struct MeshFile
 {
   std::string path;        ///< where the file is on disk
   TriangleMesh triangles;  ///< [m]
 };
+/// The mesh file named by the URI at `uri` (package://, file://, or a path relative to the scene file's
+/// folder), read at `scale` (readTriangleMesh). A URI that does not resolve or a file that cannot be read
+/// fails at `uri` with the path and the reason.
 MeshFile readMeshFile(const Context& ctx, const Field& uri, const Vec3& scale);
 
 using BodyReader = BodyDef (*)(const Context& ctx, const Field& body, const SceneSoFar& scene);
