@@ -1,4 +1,5 @@
 // Message conversions as plain structs (no ROS master): markers, state, poses and reconfigure configs.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -9,6 +10,7 @@
 #include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/tetrahedra.h"
 #include "soft_body_sim/ros/ros_converter.h"
 #include "test_util.h"
 
@@ -259,6 +261,44 @@ TEST(RosConverter, AMarkerWithoutPointsIsSentAsDelete)
   ASSERT_EQ(array.markers.size(), 2u);
   EXPECT_EQ(array.markers[0].action, visualization_msgs::Marker::ADD);
   EXPECT_EQ(array.markers[1].action, visualization_msgs::Marker::DELETE);
+}
+
+TEST(RosConverter, ASolidIsItsSurfaceAsATriangleListFacingOutward)
+{
+  // One tetrahedron, its four faces counter-clockwise seen from outside: rviz shades a triangle by
+  // (b - a) x (c - a), which must point away from the solid's centre.
+  SceneDef scene = oneBodyScene(IntegratorType::ImplicitEuler, 1e-3);
+  BodyDef& body = scene.bodies[0];
+  const Vec3 corners[4] = { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0, 0, 1) };
+  NodeArray x(3, 4);
+  for (int k = 0; k < 4; ++k)
+  {
+    body.nodes.push_back(NodeDef{ corners[k], 1.0 });
+    x.col(k) = corners[k];
+  }
+  body.tetrahedra.push_back(makeTetrahedron({ 0, 1, 2, 3 }, x, lameParameters(1.0e5, 0.3)));
+  body.surface = { { 0, 2, 1 }, { 0, 1, 3 }, { 0, 3, 2 }, { 1, 2, 3 } };
+  const visualization_msgs::MarkerArray array = RosConverter::toMarkers(buildWorld(scene), "map", ros::Time(1.0));
+  const auto surface = std::find_if(array.markers.begin(), array.markers.end(), [](const visualization_msgs::Marker& m) {
+    return m.type == visualization_msgs::Marker::TRIANGLE_LIST;
+  });
+  ASSERT_NE(surface, array.markers.end());
+  EXPECT_EQ(surface->ns, "body");
+  EXPECT_EQ(surface->action, visualization_msgs::Marker::ADD);
+  ASSERT_EQ(surface->points.size(), 12u);
+  const Vec3 centre(0.25, 0.25, 0.25);
+  for (std::size_t t = 0; t < 4; ++t)
+  {
+    const auto at = [&](std::size_t k) {
+      const geometry_msgs::Point& p = surface->points[3 * t + k];
+      return Vec3(p.x, p.y, p.z);
+    };
+    EXPECT_GT((at(1) - at(0)).cross(at(2) - at(0)).dot(at(0) - centre), 0.0) << "triangle " << t;
+  }
+  // Its nodes are drawn in a namespace of their own, which rviz can hide.
+  EXPECT_EQ(array.markers[0].type, visualization_msgs::Marker::SPHERE_LIST);
+  EXPECT_EQ(array.markers[0].ns, "body/nodes");
+  EXPECT_EQ(array.markers[0].points.size(), 4u);
 }
 
 TEST(RosConverter, NonFiniteNodesAreLeftOutOfTheMarkers)

@@ -1,6 +1,7 @@
 #include "soft_body_sim/ros/ros_converter.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "soft_body_sim/core/rods.h"
@@ -190,6 +191,34 @@ void addRodMarkers(const World& world, const std::string& frame_id, const ros::T
 }
 }  // namespace
 
+namespace
+{
+/// Each solid's boundary (BodyRange::surface) as a TRIANGLE_LIST in its body's colour (id 2 in its body's
+/// namespace): rviz shades each triangle by its normal, (b - a) x (c - a), which points out of the solid.
+/// A triangle with a node that is not finite is left out.
+void addVolumeMarkers(const World& world, const std::string& frame_id, const ros::Time& stamp,
+                      visualization_msgs::MarkerArray& array)
+{
+  const Model& model = world.model();
+  const NodeArray& x = world.state().position;
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+  {
+    const BodyRange& body = model.bodies[b];
+    if (body.surface.empty())
+      continue;
+    visualization_msgs::Marker triangles =
+        marker(frame_id, stamp, body.name, 2, visualization_msgs::Marker::TRIANGLE_LIST, 1.0, bodyColor(b));
+    for (const std::array<int, 3>& t : body.surface)
+      if (x.col(t[0]).allFinite() && x.col(t[1]).allFinite() && x.col(t[2]).allFinite())
+        for (const int node : t)
+          triangles.points.push_back(point(x.col(node)));
+    if (triangles.points.empty())
+      triangles.action = visualization_msgs::Marker::DELETE;
+    array.markers.push_back(triangles);
+  }
+}
+}  // namespace
+
 visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, const std::string& frame_id,
                                                         const ros::Time& stamp)
 {
@@ -201,8 +230,11 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
   {
     const BodyRange& body = model.bodies[b];
     const std_msgs::ColorRGBA color = bodyColor(b);
+    // A solid's nodes go in a namespace of their own, "<body>/nodes", which rviz can hide: its surface
+    // (addVolumeMarkers) is the solid.
+    const std::string nodes_namespace = body.surface.empty() ? body.name : body.name + "/nodes";
     visualization_msgs::Marker nodes =
-        marker(frame_id, stamp, body.name, 0, visualization_msgs::Marker::SPHERE_LIST, kNodeDiameter, color);
+        marker(frame_id, stamp, nodes_namespace, 0, visualization_msgs::Marker::SPHERE_LIST, kNodeDiameter, color);
     // A rod is drawn as itself (addRodMarkers): no node balls, no link lines.
     const bool rod = std::any_of(model.rods.begin(), model.rods.end(), [&](const Rod& r) { return r.first == body.first; });
     for (int i = body.first; i < body.first + body.count; ++i)
@@ -245,6 +277,7 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
     }
   }
   addRodMarkers(world, frame_id, stamp, array);
+  addVolumeMarkers(world, frame_id, stamp, array);
   addColliderMarkers(world, frame_id, stamp, array);
   return array;
 }

@@ -61,6 +61,14 @@ public:
 
   void modelChanged() override { analyzed_ = false; }
 
+  /// Solids (nodes of tetrahedra) feel the colliders inside the solve (see addSolidContacts).
+  void stepWithContacts(const Model& model, State& state, double h, int iterations, const ContactQuery* contacts) override
+  {
+    contacts_ = model.tetrahedra.empty() ? nullptr : contacts;
+    step(model, state, h, iterations);
+    contacts_ = nullptr;
+  }
+
   void step(const Model& model, State& state, double h, int iterations) override
   {
     const int n = model.nodeCount();
@@ -227,7 +235,56 @@ private:
       addRods(model, x, v, twist, h);
     if (!model.tetrahedra.empty())
       addTetrahedra(model, x, h);
+    if (contacts_ != nullptr)
+      addSolidContacts(model, x, v, h);
   }
+
+  /// A solid's nodes that the step would carry into a collider meet it inside the solve, so that the whole
+  /// solid decelerates in the step where it lands: the contact stage after the step (contact.h) stops
+  /// only the nodes that reached the surface, and a solid landing fast (a cube dropped from 5 m, its
+  /// bottom layer stopped within a step where the layer above moves more than its thickness) would turn
+  /// its bottom tetrahedra inside out. Each free node of a tetrahedron whose predicted position
+  /// x + offset lies a depth d inside a collider (ContactQuery) is held on the surface along its normal n
+  /// by a one-sided spring of stiffness k with h^2 k = kContactStiffness times its diagonal block's mean
+  /// eigenvalue b: the block gains h^2 k n n^T and rhs_ h k d n, so that the solve removes all but about
+  /// 1 / kContactStiffness of d. Coulomb friction acts in the same solve, as a damping of the velocity
+  /// relative to the surface across n, of coefficient c = friction N / max(|v_t|, kStickSpeed) with
+  /// N = b d / h^2 the force that stops the node's approach (its momentum b d / h over the step): the block
+  /// gains h c (I - n n^T) and rhs_ -h c v_t. Sliding (h c << b) it takes friction N h / b of the
+  /// tangential speed v_t, as Coulomb's law; where that is more than v_t (h c >> b) the node sticks. The
+  /// contact stage then removes what depth remains. Other bodies keep the contact stage alone (their
+  /// nodes' own inertia is all that a landing stops).
+  void addSolidContacts(const Model& model, const NodeArray& x, const NodeArray& v, double h)
+  {
+    NodeContact contact;
+    for (int i = 0; i < model.nodeCount(); ++i)
+    {
+      if (!solid_node_[static_cast<std::size_t>(i)] || !model.isFree(i))
+        continue;
+      if (!contacts_->touching(model, i, x.col(i) + offset_.col(i), 0.0, contact) || !(contact.depth > 0.0))
+        continue;
+      Matrix3& d = diagonal_[static_cast<std::size_t>(i)];
+      const Vec3 n = contact.normal;
+      const double block = d.trace() / 3.0;  // b [kg]
+      const double scaled = kContactStiffness * block;  // h^2 k
+      rhs_.col(i) += (scaled / h * contact.depth) * n;
+      d += scaled * (n * n.transpose());
+      if (!(contact.friction > 0.0))
+        continue;
+      const Vec3 relative = v.col(i) - contact.velocity;
+      const Vec3 tangential = relative - relative.dot(n) * n;
+      const double damping = contact.friction * block * contact.depth / (h * h) /
+                             std::max(tangential.norm(), kStickSpeed);  // c [kg/s]
+      rhs_.col(i) -= h * damping * tangential;
+      d += h * damping * (Matrix3::Identity() - n * n.transpose());
+    }
+  }
+
+  /// [m/s] below this tangential speed a solid's contact sticks (its friction's damping no longer grows).
+  static constexpr double kStickSpeed = 1e-4;
+
+  /// A held contact's stiffness relative to its node's diagonal block (see addSolidContacts).
+  static constexpr double kContactStiffness = 1000.0;
 
   /// The tetrahedra's blocks (their diagonal ones into diagonal_) and h (f + K offset) in rhs_ (K = -df/dx).
   /// The condition estimate takes each node's block of one tetrahedron as a spring's (see condition_).
@@ -509,6 +566,10 @@ private:
         }
       }
     }
+    solid_node_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
+    for (const Tetrahedron& tet : model.tetrahedra)
+      for (const int node : tet.nodes)
+        solid_node_[static_cast<std::size_t>(node)] = 1;
     tet_slot_.assign(6 * model.tetrahedra.size(), -1);
     for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
       for (std::size_t p = 0; p < kTetPairs.size(); ++p)
@@ -648,6 +709,8 @@ private:
   std::vector<int> rod_slot_;            ///< per rod vertex, three: each node pair's slot, or -1
   std::vector<TetBlock> tet_blocks_;     ///< per tetrahedron
   std::vector<int> tet_slot_;            ///< per tetrahedron, six: each node pair's slot, or -1
+  std::vector<char> solid_node_;         ///< per node: a node of a tetrahedron
+  const ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
 };
 }  // namespace
 
