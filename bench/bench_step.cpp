@@ -20,6 +20,10 @@
 // falls and lands (its links moving past each other: the candidate pairs found again more often).
 // BM_ClothOnSphere/<plain|self_collision>: a 64 x 64 cloth draping over a sphere, without and with
 // self-collision (its nodes as balls).
+// BM_SoftBox/<tetrahedra>: a 10 cm soft box (type: volume, E = 50 kPa, nu = 0.3, 100 kg/m^3) hanging from
+// its top face, implicit_euler at 1/60 s, about 1,000 to 100,000 tetrahedra; items = tetrahedra, so the
+// cost per tetrahedron per step and its growth with the size. BM_TetKernel: the tetrahedron's force and
+// projected stiffness alone (tetForcesAndStiffness), per tetrahedron, on that box sagging.
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
 #include <cmath>
@@ -29,7 +33,9 @@
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/bodies/rope.h"
+#include "soft_body_sim/core/bodies/volume.h"
 #include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/tetrahedra.h"
 #include "../src/core/integrators/integrator_kit.h"
 #include "large_cloth.h"
 #include "test_meshes.h"
@@ -197,6 +203,55 @@ void BM_Cable(benchmark::State& bench, bool rod)
     benchmark::DoNotOptimize(world.state().position.data());
   }
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(cable.nodes - 1));
+}
+
+/// The box of BM_SoftBox with about `tetrahedra` tetrahedra (TetGen makes about 3.5 per resolution^3 /
+/// (2 sqrt 2) of volume), hanging from its top face.
+SceneDef softBox(double tetrahedra)
+{
+  VolumeDef box;
+  box.size = Vec3(0.1, 0.1, 0.1);
+  box.resolution = std::cbrt(3.5 * 2.0 * std::sqrt(2.0) * 1e-3 / tetrahedra);
+  box.youngs_modulus = 5.0e4;
+  box.density = 100.0;
+  box.pinned_faces = { "z_max" };
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 1, 1 };
+  scene.bodies.push_back(buildVolume("box", box));
+  return scene;
+}
+
+void BM_SoftBox(benchmark::State& bench)
+{
+  World world = buildWorld(softBox(static_cast<double>(bench.range(0))));
+  world.step();  // the pattern is analysed on the first step
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.counters["tetrahedra"] = static_cast<double>(world.model().tetrahedra.size());
+  bench.counters["nodes"] = world.model().nodeCount();
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(world.model().tetrahedra.size()));
+}
+
+void BM_TetKernel(benchmark::State& bench)
+{
+  World world = buildWorld(softBox(10000.0));
+  for (int k = 0; k < 30; ++k)
+    world.step();  // sagging: every tetrahedron strained
+  const Model& model = world.model();
+  const NodeArray& x = world.state().position;
+  Eigen::Matrix<double, 3, 4> force;
+  TetStiffness stiffness;
+  for (auto _ : bench)
+    for (const Tetrahedron& tet : model.tetrahedra)
+    {
+      tetForcesAndStiffness(tet, x, true, force, stiffness);
+      benchmark::DoNotOptimize(stiffness.blocks[0].data());
+    }
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.tetrahedra.size()));
 }
 
 enum class Shape
@@ -476,6 +531,8 @@ BENCHMARK_CAPTURE(BM_CoiledRopeFalling, plain, false)->Arg(1000)->Arg(10000);
 BENCHMARK_CAPTURE(BM_CoiledRopeFalling, self_collision, true)->Arg(1000)->Arg(10000);
 BENCHMARK_CAPTURE(BM_ClothOnSphere, plain, false);
 BENCHMARK_CAPTURE(BM_ClothOnSphere, self_collision, true);
+BENCHMARK(BM_SoftBox)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_TetKernel);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
 

@@ -93,12 +93,16 @@ public:
         else
           linear_x_.col(i) += h * v_k.col(i);
       }
-      assemble(model, k == 0 ? start_x_ : linear_x_, v_k, state.twist, h);
+      assemble(model, k == 0 ? start_x_ : linear_x_, v_k, state.twist, h, k == 0);
       solve(model);
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
           state.velocity.col(i) += delta_v_.col(i);
+      if (contacts_ != nullptr && k + 1 < iterations)
+        letGoPullingHolds(h);
     }
+    if (contacts_ != nullptr)
+      noteHoldForces(h);
     for (int i = 0; i < n; ++i)
       if (model.isFree(i))
         state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
@@ -142,7 +146,8 @@ private:
 
   /// Fills the blocks of A = M - h D - h^2 K and rhs_ (see the class comment) at (x, v), the rods' twists
   /// counted on from `twist` (State::twist).
-  void assemble(const Model& model, const NodeArray& x, const NodeArray& v, const Eigen::VectorXd& twist, double h)
+  void assemble(const Model& model, const NodeArray& x, const NodeArray& v, const Eigen::VectorXd& twist, double h,
+                bool first_iteration)
   {
     const int n = model.nodeCount();
     rhs_.resize(3, n);
@@ -236,49 +241,120 @@ private:
     if (!model.tetrahedra.empty())
       addTetrahedra(model, x, h);
     if (contacts_ != nullptr)
-      addSolidContacts(model, x, v, h);
+      addSolidContacts(model, x, v, h, first_iteration);
   }
 
-  /// A solid's nodes that the step would carry into a collider meet it inside the solve, so that the whole
-  /// solid decelerates in the step where it lands: the contact stage after the step (contact.h) stops
-  /// only the nodes that reached the surface, and a solid landing fast (a cube dropped from 5 m, its
-  /// bottom layer stopped within a step where the layer above moves more than its thickness) would turn
-  /// its bottom tetrahedra inside out. Each free node of a tetrahedron whose predicted position
-  /// x + offset lies a depth d inside a collider (ContactQuery) is held on the surface along its normal n
-  /// by a one-sided spring of stiffness k with h^2 k = kContactStiffness times its diagonal block's mean
-  /// eigenvalue b: the block gains h^2 k n n^T and rhs_ h k d n, so that the solve removes all but about
-  /// 1 / kContactStiffness of d. Coulomb friction acts in the same solve, as a damping of the velocity
-  /// relative to the surface across n, of coefficient c = friction N / max(|v_t|, kStickSpeed) with
-  /// N = b d / h^2 the force that stops the node's approach (its momentum b d / h over the step): the block
-  /// gains h c (I - n n^T) and rhs_ -h c v_t. Sliding (h c << b) it takes friction N h / b of the
-  /// tangential speed v_t, as Coulomb's law; where that is more than v_t (h c >> b) the node sticks. The
-  /// contact stage then removes what depth remains. Other bodies keep the contact stage alone (their
-  /// nodes' own inertia is all that a landing stops).
-  void addSolidContacts(const Model& model, const NodeArray& x, const NodeArray& v, double h)
+  /// A solid's node held on a collider's surface in the solve (addSolidContacts).
+  struct SolidContact
   {
-    NodeContact contact;
-    for (int i = 0; i < model.nodeCount(); ++i)
+    int node;
+    NodeContact contact;  ///< as found at the step's first Newton iteration
+    Vec3 found_at;        ///< [m] the node's predicted position then
+    double found_depth;   ///< [m] its depth then, at the step's end (the surface moved on by h v_s)
+    double depth;         ///< d [m] at the step's end, the node at this iteration's predicted position
+    double scaled;        ///< h^2 k [kg] in this iteration
+  };
+
+  /// A solid's nodes that the step would carry into a collider meet it inside the solve, so that the whole
+  /// solid decelerates in the step where it lands and rests on the surface without sinking into it step
+  /// after step: the contact stage after the step (contact.h) stops only the nodes that reached the
+  /// surface, so a solid landing fast (a cube dropped from 5 m, its bottom layer stopped within a step
+  /// where the layer above moves more than its thickness) would turn its bottom tetrahedra inside out, and
+  /// a resting one would fall freely in every solve and be pushed back only at its bottom nodes (measured:
+  /// a 8 cm box sagging 1.8 mm at 4 ms steps, whatever its stiffness).
+  /// A free node of a tetrahedron is held when its predicted position x + offset lies, at the step's end
+  /// (the surface moved on by h v_s), inside a collider (ContactQuery) at a depth d > 0, or less than
+  /// |g| h^2 outside it (d > -|g| h^2: resting on it) unless its hold pulled it at the end of the last
+  /// step (it is leaving). It is held on the surface along the normal n by a spring of
+  /// stiffness k with h^2 k = kContactStiffness times its diagonal block's mean eigenvalue b: the block
+  /// gains h^2 k n n^T and rhs_ h k d n, so that the solve leaves about 1 / kContactStiffness of d.
+  /// Coulomb friction acts in the same solve, as a damping of the velocity relative to the surface across
+  /// n, of coefficient c = friction N / max(|v_t|, kStickSpeed), N the larger of b d / h^2, the force that
+  /// stops the node's approach (its momentum b d / h over the step), and the force its hold took in the
+  /// last step (noteHoldForces; a resting node's weight): the block gains h c (I - n n^T) and
+  /// rhs_ -h c v_t. Sliding (h c << b) it takes friction N h / b of the tangential speed v_t, as
+  /// Coulomb's law; where that is more than v_t (h c >> b) the node sticks. The contact stage then
+  /// removes what depth remains. Other bodies keep the contact stage alone.
+  void addSolidContacts(const Model& model, const NodeArray& x, const NodeArray& v, double h, bool first_iteration)
+  {
+    if (first_iteration)
+      findSolidContacts(model, x, h);
+    for (SolidContact& c : solid_contacts_)
     {
-      if (!solid_node_[static_cast<std::size_t>(i)] || !model.isFree(i))
-        continue;
-      if (!contacts_->touching(model, i, x.col(i) + offset_.col(i), 0.0, contact) || !(contact.depth > 0.0))
-        continue;
+      const int i = c.node;
+      const Vec3 n = c.contact.normal;
+      // The same surface, planar about where it was found, at this iteration's predicted position.
+      c.depth = c.found_depth - n.dot(x.col(i) + offset_.col(i) - c.found_at);
       Matrix3& d = diagonal_[static_cast<std::size_t>(i)];
-      const Vec3 n = contact.normal;
       const double block = d.trace() / 3.0;  // b [kg]
-      const double scaled = kContactStiffness * block;  // h^2 k
-      rhs_.col(i) += (scaled / h * contact.depth) * n;
-      d += scaled * (n * n.transpose());
-      if (!(contact.friction > 0.0))
+      c.scaled = kContactStiffness * block;  // h^2 k
+      rhs_.col(i) += (c.scaled / h * c.depth) * n;
+      d += c.scaled * (n * n.transpose());
+      const double normal_force = std::max(block * c.depth / (h * h), hold_force_[static_cast<std::size_t>(i)]);
+      if (!(c.contact.friction > 0.0 && normal_force > 0.0))
         continue;
-      const Vec3 relative = v.col(i) - contact.velocity;
+      const Vec3 relative = v.col(i) - c.contact.velocity;
       const Vec3 tangential = relative - relative.dot(n) * n;
-      const double damping = contact.friction * block * contact.depth / (h * h) /
-                             std::max(tangential.norm(), kStickSpeed);  // c [kg/s]
+      const double damping = c.contact.friction * normal_force / std::max(tangential.norm(), kStickSpeed);  // c [kg/s]
       rhs_.col(i) -= h * damping * tangential;
       d += h * damping * (Matrix3::Identity() - n * n.transpose());
     }
   }
+
+  /// The holds of a step (addSolidContacts), found at its first Newton iteration and kept through the others.
+  void findSolidContacts(const Model& model, const NodeArray& x, double h)
+  {
+    NodeContact contact;
+    solid_contacts_.clear();
+    const double margin = model.gravity.norm() * h * h;
+    for (int i = 0; i < model.nodeCount(); ++i)
+    {
+      if (!solid_node_[static_cast<std::size_t>(i)] || !model.isFree(i))
+        continue;
+      const Vec3 predicted = x.col(i) + offset_.col(i);
+      if (!contacts_->touching(model, i, predicted, margin, contact))
+        continue;
+      const double depth = contact.depth + h * contact.velocity.dot(contact.normal);
+      if (depth > (pulled_[static_cast<std::size_t>(i)] ? 0.0 : -margin))
+        solid_contacts_.push_back({ i, contact, predicted, depth, depth, 0.0 });
+    }
+  }
+
+  /// k (d - h n . dv) [N]: the force hold `c` took in the Newton iteration just solved (> 0 pushing).
+  double holdForce(const SolidContact& c, double h) const
+  {
+    return c.scaled / (h * h) * (c.depth - h * c.contact.normal.dot(delta_v_.col(c.node)));
+  }
+
+  /// Drops the holds that pulled in the Newton iteration just solved, for the step's later iterations: the
+  /// ballistic prediction that found them holds every node that would cross the surface in the step, also
+  /// those that the solid's own elasticity stops above it (a landing's second layer of nodes; held, it
+  /// would be pressed onto the first, its tetrahedra flat).
+  void letGoPullingHolds(double h)
+  {
+    solid_contacts_.erase(std::remove_if(solid_contacts_.begin(), solid_contacts_.end(),
+                                         [&](const SolidContact& c) { return holdForce(c, h) < 0.0; }),
+                          solid_contacts_.end());
+  }
+
+  /// The force each hold of the last Newton iteration took, k (d - h n . dv) at its node's new depth: where
+  /// it pulled (< 0) the node is held in the next step only if it is carried into the surface
+  /// (addSolidContacts), where it pushed it is the
+  /// normal force of the node's friction in the next step (a node resting on the surface, whose predicted
+  /// depth is about 0, presses on it with its share of the weight). Every other solid node may be held
+  /// again, with no force known.
+  void noteHoldForces(double h)
+  {
+    std::fill(pulled_.begin(), pulled_.end(), 0);
+    std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
+    for (const SolidContact& c : solid_contacts_)
+    {
+      const double force = holdForce(c, h);
+      pulled_[static_cast<std::size_t>(c.node)] = force < 0.0;
+      hold_force_[static_cast<std::size_t>(c.node)] = std::max(force, 0.0);
+    }
+  }
+
 
   /// [m/s] below this tangential speed a solid's contact sticks (its friction's damping no longer grows).
   static constexpr double kStickSpeed = 1e-4;
@@ -567,6 +643,10 @@ private:
       }
     }
     solid_node_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
+    pulled_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
+    hold_force_.assign(static_cast<std::size_t>(model.nodeCount()), 0.0);
+    solid_contacts_.clear();
+    solid_contacts_.reserve(static_cast<std::size_t>(model.nodeCount()));
     for (const Tetrahedron& tet : model.tetrahedra)
       for (const int node : tet.nodes)
         solid_node_[static_cast<std::size_t>(node)] = 1;
@@ -710,6 +790,9 @@ private:
   std::vector<TetBlock> tet_blocks_;     ///< per tetrahedron
   std::vector<int> tet_slot_;            ///< per tetrahedron, six: each node pair's slot, or -1
   std::vector<char> solid_node_;         ///< per node: a node of a tetrahedron
+  std::vector<char> pulled_;             ///< per node: its hold pulled it in the last step (let go for a step)
+  std::vector<double> hold_force_;       ///< per node: [N] its hold's push in the last step, else 0
+  std::vector<SolidContact> solid_contacts_;  ///< the solids' holds of the last Newton iteration
   const ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
 };
 }  // namespace
