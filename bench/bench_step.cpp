@@ -20,9 +20,9 @@
 // falls and lands (its links moving past each other: the candidate pairs found again more often).
 // BM_ClothOnSphere/<plain|self_collision>: a 64 x 64 cloth draping over a sphere, without and with
 // self-collision (its nodes as balls).
-// BM_SoftBox/<tetrahedra>: a 10 cm soft box (type: volume, E = 50 kPa, nu = 0.3, 100 kg/m^3) hanging from
-// its top face, implicit_euler at 1/60 s, about 1,000 to 100,000 tetrahedra; items = tetrahedra, so the
-// cost per tetrahedron per step and its growth with the size. BM_TetKernel: the tetrahedron's force and
+// BM_SoftBox/<cheaper|direct|iterative>/<n>: a 10 cm soft box (type: volume, E = 50 kPa, nu = 0.3,
+// 100 kg/m^3) hanging from its top face, implicit_euler at 1/60 s, about 1,000 to 100,000 tetrahedra, its
+// linear solve made each way; items = tetrahedra, so the cost per tetrahedron per step and its growth. BM_TetKernel: the tetrahedron's force and
 // projected stiffness alone (tetForcesAndStiffness), per tetrahedron, on that box sagging.
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
@@ -34,6 +34,7 @@
 #include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/bodies/volume.h"
+#include "soft_body_sim/core/bodies/volume_mesh.h"
 #include "soft_body_sim/core/forces.h"
 #include "soft_body_sim/core/tetrahedra.h"
 #include "../src/core/integrators/integrator_kit.h"
@@ -205,13 +206,13 @@ void BM_Cable(benchmark::State& bench, bool rod)
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(cable.nodes - 1));
 }
 
-/// The box of BM_SoftBox with about `tetrahedra` tetrahedra (TetGen makes about 3.5 per resolution^3 /
-/// (2 sqrt 2) of volume), hanging from its top face.
+/// The box of BM_SoftBox meshed for at most about `tetrahedra` tetrahedra (kTetsPerMaxVolume per
+/// resolution^3 / (2 sqrt 2) of volume; TetGen makes about 0.6 of that on this box), hanging from its top face.
 SceneDef softBox(double tetrahedra)
 {
   VolumeDef box;
   box.size = Vec3(0.1, 0.1, 0.1);
-  box.resolution = std::cbrt(3.5 * 2.0 * std::sqrt(2.0) * 1e-3 / tetrahedra);
+  box.resolution = std::cbrt(kTetsPerMaxVolume * 2.0 * std::sqrt(2.0) * 1e-3 / tetrahedra);
   box.youngs_modulus = 5.0e4;
   box.density = 100.0;
   box.pinned_faces = { "z_max" };
@@ -222,18 +223,23 @@ SceneDef softBox(double tetrahedra)
   return scene;
 }
 
-void BM_SoftBox(benchmark::State& bench)
+/// The soft box's step with its linear solve made each way (cheaper: the rule's choice, what a scene gets).
+void BM_SoftBox(benchmark::State& bench, LinearSolve solve)
 {
-  World world = buildWorld(softBox(static_cast<double>(bench.range(0))));
-  world.step();  // the pattern is analysed on the first step
+  const World world = buildWorld(softBox(static_cast<double>(bench.range(0))));
+  const Model& model = world.model();
+  State state = world.state();
+  const std::unique_ptr<Integrator> integrator = makeImplicitEuler(solve);
+  constexpr double h = 1.0 / 60.0;
+  integrator->step(model, state, h, 1);  // the pattern is analysed on the first step
   for (auto _ : bench)
   {
-    world.step();
-    benchmark::DoNotOptimize(world.state().position.data());
+    integrator->step(model, state, h, 1);
+    benchmark::DoNotOptimize(state.position.data());
   }
-  bench.counters["tetrahedra"] = static_cast<double>(world.model().tetrahedra.size());
-  bench.counters["nodes"] = world.model().nodeCount();
-  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(world.model().tetrahedra.size()));
+  bench.counters["tetrahedra"] = static_cast<double>(model.tetrahedra.size());
+  bench.counters["nodes"] = model.nodeCount();
+  bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.tetrahedra.size()));
 }
 
 void BM_TetKernel(benchmark::State& bench)
@@ -531,7 +537,9 @@ BENCHMARK_CAPTURE(BM_CoiledRopeFalling, plain, false)->Arg(1000)->Arg(10000);
 BENCHMARK_CAPTURE(BM_CoiledRopeFalling, self_collision, true)->Arg(1000)->Arg(10000);
 BENCHMARK_CAPTURE(BM_ClothOnSphere, plain, false);
 BENCHMARK_CAPTURE(BM_ClothOnSphere, self_collision, true);
-BENCHMARK(BM_SoftBox)->Arg(1000)->Arg(10000)->Arg(100000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SoftBox, cheaper, LinearSolve::Cheaper)->Arg(1700)->Arg(17000)->Arg(170000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SoftBox, direct, LinearSolve::Direct)->Arg(1700)->Arg(17000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SoftBox, iterative, LinearSolve::Iterative)->Arg(1700)->Arg(17000)->Arg(170000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TetKernel);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
