@@ -15,6 +15,7 @@
 #include "soft_body_sim/core/bodies/jelly.h"
 #include "soft_body_sim/core/bodies/limb.h"
 #include "soft_body_sim/core/bodies/rod.h"
+#include "soft_body_sim/core/bodies/volume.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/scene_def.h"
 
@@ -276,6 +277,46 @@ TEST(StepAllocation, ImplicitEulerOnARodTurnedByItsAnchorAndAGraspAllocatesNothi
   // Turned 9.95 rad against the grasp's -3.98: the twist after the grasp counts on past whole turns (less
   // than their difference: some of the turn went into its writhe as it sagged out of line).
   EXPECT_GT(world.state().twist[15], 2.0 * M_PI);
+}
+
+// A soft solid (tetrahedra.h) landing on the floor and pressed by a moving pad, a corner anchored and a
+// grasp on its far side: tetrahedron blocks, holds on colliders found, let go and kept, friction.
+TEST(StepAllocation, ImplicitEulerOnAPressedSolidAllocatesNothing)
+{
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.step = StepSettings{ 1.0 / 120.0, 1, 2 };
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  Box pad;
+  pad.at.name = "pad";
+  pad.at.position = Vec3(0.0, 0.0, 0.16);
+  pad.at.velocity = Vec3(0.0, 0.0, -0.05);
+  pad.at.friction = 0.5;
+  pad.size = Vec3(0.2, 0.2, 0.02);
+  scene.colliders.boxes.push_back(pad);
+  VolumeDef box;
+  box.size = Vec3(0.1, 0.1, 0.1);
+  box.resolution = 0.03;
+  box.position = Vec3(0.0, 0.0, 0.06);
+  BodyDef body = buildVolume("box", box);
+  body.anchors = { AnchorDef{ "corner", 0 } };
+  scene.bodies.push_back(body);
+  World world = buildWorld(scene);
+  const int corner = *world.findAnchor("box", "corner");
+  const Vec3 start = world.state().position.col(world.model().anchors[0].node);
+  const Vec3 far_side = world.state().position.col(world.model().nodeCount() - 1);
+  world.grasp("hand", "box", RigidPose{ far_side, Eigen::Quaterniond::Identity() }, 0.01);
+  world.step();
+  const long allocations = allocationsOf([&] {
+    for (int n = 0; n < 200; ++n)
+    {
+      world.moveAnchor(corner, start + Vec3(0.0, 0.0, -0.0001 * n));
+      world.moveGrasp("hand", RigidPose{ far_side + Vec3(0.0001 * n, 0.0, 0.0), Eigen::Quaterniond::Identity() });
+      world.step();
+    }
+  });
+  EXPECT_EQ(allocations, 0);
+  EXPECT_TRUE(world.state().position.allFinite());
 }
 
 TEST(StepAllocation, TheCounterSeesOperatorNewAndEigen)
