@@ -46,7 +46,7 @@ Eigen::Matrix<double, 3, 4> shapeGradients(const Tetrahedron& tet)
 /// lambda' = lambda + mu (see tetrahedra.h).
 double volumeModulus(const Tetrahedron& tet) { return tet.lambda + tet.mu; }
 
-/// vec(U M V^T) for M = a e_i e_j^T + b e_j e_i^T (+ diag(w) when i == j is not used): column-major.
+/// vec(U M V^T), column-major: the mode of F-space that M is in the frame of the SVD (U, V).
 Vector9 mode(const Matrix3& U, const Matrix3& V, const Matrix3& M)
 {
   const Matrix3 Q = U * M * V.transpose();

@@ -51,7 +51,7 @@ using Matrix3 = Eigen::Matrix3d;
 /// positive definite through any strain and inversion.
 /// A spring's 3x3 block is a u u^T + b I (below), a cell's h^2 S g_k g_l^T, a rod vertex's
 /// (h^2 + h beta) 2 w J_k^T J_l, a tetrahedron's h^2 K_ab. The matrix's pattern (which
-/// node pairs couple) depends only on the springs, the cells and which nodes are pinned: it is analysed
+/// node pairs couple) depends only on the elements and which nodes are pinned: it is analysed
 /// on the first step and after every model change, and each Newton iteration only writes its values and
 /// factorises. Every array is sized once: a step allocates nothing after the first.
 class ImplicitEuler final : public ForceBasedIntegrator
@@ -261,7 +261,7 @@ private:
   /// surface, so a solid landing fast (a cube dropped from 5 m, its bottom layer stopped within a step
   /// where the layer above moves more than its thickness) would turn its bottom tetrahedra inside out, and
   /// a resting one would fall freely in every solve and be pushed back only at its bottom nodes (measured:
-  /// a 8 cm box sagging 1.8 mm at 4 ms steps, whatever its stiffness).
+  /// an 8 cm box sagging 1.8 mm at 4 ms steps, whatever its stiffness).
   /// A free node of a tetrahedron is held when its predicted position x + offset lies, at the step's end
   /// (the surface moved on by h v_s), inside a collider (ContactQuery) at a depth d > 0, or less than
   /// |g| h^2 outside it (d > -|g| h^2: resting on it) unless its hold pulled it at the end of the last
@@ -339,10 +339,9 @@ private:
 
   /// The force each hold of the last Newton iteration took, k (d - h n . dv) at its node's new depth: where
   /// it pulled (< 0) the node is held in the next step only if it is carried into the surface
-  /// (addSolidContacts), where it pushed it is the
-  /// normal force of the node's friction in the next step (a node resting on the surface, whose predicted
-  /// depth is about 0, presses on it with its share of the weight). Every other solid node may be held
-  /// again, with no force known.
+  /// (addSolidContacts), where it pushed it is the normal force of the node's friction in the next step (a
+  /// node resting on the surface, whose predicted depth is about 0, presses on it with its share of the
+  /// weight). Every other solid node may be held again, with no force known.
   void noteHoldForces(double h)
   {
     std::fill(pulled_.begin(), pulled_.end(), 0);
@@ -354,7 +353,6 @@ private:
       hold_force_[static_cast<std::size_t>(c.node)] = std::max(force, 0.0);
     }
   }
-
 
   /// [m/s] below this tangential speed a solid's contact sticks (its friction's damping no longer grows).
   static constexpr double kStickSpeed = 1e-4;
