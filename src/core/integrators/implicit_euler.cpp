@@ -290,6 +290,7 @@ private:
       c.scaled = kContactStiffness * block;  // h^2 k
       rhs_.col(i) += (c.scaled / h * c.depth) * n;
       d += c.scaled * (n * n.transpose());
+      // A hold that pulled in the last step (< 0) adds nothing: only the approach's force presses then.
       const double normal_force = std::max(block * c.depth / (h * h), hold_force_[static_cast<std::size_t>(i)]);
       if (!(c.contact.friction > 0.0 && normal_force > 0.0))
         continue;
@@ -315,7 +316,7 @@ private:
       if (!contacts_->touching(model, i, predicted, margin, contact))
         continue;
       const double depth = contact.depth + h * contact.velocity.dot(contact.normal);
-      if (depth > (pulled_[static_cast<std::size_t>(i)] ? 0.0 : -margin))
+      if (depth > (hold_force_[static_cast<std::size_t>(i)] < 0.0 ? 0.0 : -margin))
         solid_contacts_.push_back({ i, contact, predicted, depth, depth, 0.0 });
     }
   }
@@ -344,14 +345,9 @@ private:
   /// weight). Every other solid node may be held again, with no force known.
   void noteHoldForces(double h)
   {
-    std::fill(pulled_.begin(), pulled_.end(), 0);
     std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
     for (const SolidContact& c : solid_contacts_)
-    {
-      const double force = holdForce(c, h);
-      pulled_[static_cast<std::size_t>(c.node)] = force < 0.0;
-      hold_force_[static_cast<std::size_t>(c.node)] = std::max(force, 0.0);
-    }
+      hold_force_[static_cast<std::size_t>(c.node)] = holdForce(c, h);
   }
 
   /// [m/s] below this tangential speed a solid's contact sticks (its friction's damping no longer grows).
@@ -641,7 +637,6 @@ private:
       }
     }
     solid_node_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
-    pulled_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
     hold_force_.assign(static_cast<std::size_t>(model.nodeCount()), 0.0);
     solid_contacts_.clear();
     solid_contacts_.reserve(static_cast<std::size_t>(model.nodeCount()));
@@ -788,8 +783,9 @@ private:
   std::vector<TetBlock> tet_blocks_;     ///< per tetrahedron
   std::vector<int> tet_slot_;            ///< per tetrahedron, six: each node pair's slot, or -1
   std::vector<char> solid_node_;         ///< per node: a node of a tetrahedron
-  std::vector<char> pulled_;             ///< per node: its hold pulled it in the last step (let go for a step)
-  std::vector<double> hold_force_;       ///< per node: [N] its hold's push in the last step, else 0
+  /// per node: [N] the force its hold took in the last step (> 0 pushing, < 0 pulling: let go for a step),
+  /// 0 without a hold
+  std::vector<double> hold_force_;
   std::vector<SolidContact> solid_contacts_;  ///< the solids' holds of the last Newton iteration
   const ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
 };
