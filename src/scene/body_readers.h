@@ -84,6 +84,13 @@ BodyDef buildBody(const Context& ctx, const Field& field, const Def& def, Build 
   }
 }
 
+/// True if a `pinned:` entry reads as a node index (it starts as a number does), not a name (a grid
+/// corner, a box face).
+inline bool readsAsNodeIndex(const std::string& text)
+{
+  return !text.empty() && std::string("+-0123456789").find(text[0]) != std::string::npos;
+}
+
 /// A mesh file as read: a mesh collider's shape or a volume's surface.
 struct MeshFile
 {

@@ -72,8 +72,8 @@ inline std::vector<int> readPinned(const Context& ctx, const Field& field, int n
   std::vector<int> pinned;
   for (const Field& item : requireList(ctx, field))
   {
-    const bool named = rows > 0 && item.node.IsScalar() && !item.node.Scalar().empty() &&
-                       std::string("+-0123456789").find(item.node.Scalar()[0]) == std::string::npos;
+    const bool named =
+        rows > 0 && item.node.IsScalar() && !item.node.Scalar().empty() && !readsAsNodeIndex(item.node.Scalar());
     if (named)
     {
       const std::optional<int> corner = gridCornerNode(item.node.Scalar(), columns, rows);

@@ -28,7 +28,7 @@ void readPinnedNodesAndFaces(const Context& ctx, const Field& field, VolumeDef& 
     if (!item.node.IsScalar())
       ctx.fail(item, "expected a node index or a face name, got " + describe(item.node));
     const std::string& text = item.node.Scalar();
-    if (!text.empty() && std::string("+-0123456789").find(text[0]) != std::string::npos)
+    if (readsAsNodeIndex(text))
       volume.pinned_nodes.push_back(readInt(ctx, item));
     else
       volume.pinned_faces.push_back(readNonEmptyString(ctx, item));
