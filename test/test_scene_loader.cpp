@@ -1630,8 +1630,8 @@ TEST(SceneLoader, AVolumesMistakesAreNamedAtTheirKeys)
                    { "unknown face 'top'", "x_min, x_max, y_min, y_max, z_min, z_max" });
   expectSceneError("bodies:\n  - " + box + ", pinned: [100000]}\n", "bad.yaml:2: bodies[0].pinned",
                    { "out of range" });
-  expectSceneError("bodies:\n  - " + box + ", pressure: 1000}\n", "bad.yaml:2: bodies[0].pressure",
-                   { "not supported yet" });
+  expectSceneError("bodies:\n  - " + box + ", pressure: -1000}\n", "bad.yaml:2: bodies[0].pressure",
+                   { ">= 0 [Pa]" });
   expectSceneError("bodies:\n  - {name: s, type: volume, resolution: 0.02, position: [0, 0, 1], "
                    "youngs_modulus: 5e4, density: 100, shape: box}\n",
                    "bad.yaml:2: bodies[0].shape", { "needs size" });

@@ -54,6 +54,23 @@ Matrix12 assembled(const TetStiffness& k)
   return m;
 }
 
+/// The materials to test: Poisson's ratios 0, 0.3 and 0.49 without gas, and 0.3 with a gas of p0 = 2e5 Pa,
+/// five times the shear modulus, so that the gas's terms dominate.
+struct Material
+{
+  double nu;
+  double pressure;
+};
+const std::vector<Material> kMaterials{ { 0.0, 0.0 }, { 0.3, 0.0 }, { 0.49, 0.0 }, { 0.3, 2.0e5 } };
+
+/// irregularTetrahedron of `material`.
+Tetrahedron irregularTetrahedron(NodeArray& x, const Material& material)
+{
+  Tetrahedron tet = irregularTetrahedron(x, material.nu);
+  tet.pressure = material.pressure;
+  return tet;
+}
+
 /// Deformations to test at: stretched, sheared, compressed, near flat and inverted (J < 0).
 std::vector<Matrix3> deformations()
 {
@@ -120,6 +137,33 @@ TEST(Tetrahedra, SmallStrainStressIsLinearElasticitys)
   }
 }
 
+TEST(Tetrahedra, AGasIsAnIsothermalIdealGasInAnAtmosphereOfItsRestPressure)
+{
+  NodeArray x;
+  Tetrahedron tet = irregularTetrahedron(x, 0.3);
+  tet.pressure = 2.0e5;
+  // At small strain the gas adds its bulk modulus p0 (an isothermal ideal gas's) to lambda's:
+  // P = 2 mu e + (lambda + p0) tr(e) I + O(|e|^2).
+  Matrix3 e;
+  e << 3.0, 1.0, -0.5, 1.0, -2.0, 0.7, -0.5, 0.7, 1.5;
+  e *= 1e-6;
+  const Matrix3 linear = 2.0 * tet.mu * e + (tet.lambda + tet.pressure) * e.trace() * Matrix3::Identity();
+  EXPECT_LT((firstPiolaStress(tet, Matrix3::Identity() + e) - linear).norm(), 1e-5 * linear.norm());
+  // A rotation compresses no gas.
+  const Matrix3 R = Eigen::AngleAxisd(2.1, Vec3(0.3, -1.0, 0.4).normalized()).toRotationMatrix();
+  EXPECT_LT(firstPiolaStress(tet, R).norm(), 1e-12 * tet.mu);
+  // At any volume ratio J above the barrier, the gas alone (no solid) pushes with Boyle's law: Cauchy stress
+  // sigma = P F^T / J = -(p0 / J - p0) I, the absolute pressure p0 / J less the atmosphere's p0.
+  tet.mu = 0.0;
+  tet.lambda = 0.0;
+  for (const double J : { 0.2, 0.5, 0.9, 1.5, 3.0 })
+  {
+    const Matrix3 F = std::cbrt(J) * Matrix3::Identity();
+    const Matrix3 sigma = firstPiolaStress(tet, F) * F.transpose() / J;
+    EXPECT_TRUE(sigma.isApprox(-(tet.pressure / J - tet.pressure) * Matrix3::Identity(), 1e-12)) << "J = " << J;
+  }
+}
+
 TEST(Tetrahedra, UniaxialStretchEnergyHasItsClosedForm)
 {
   NodeArray x;
@@ -137,9 +181,9 @@ TEST(Tetrahedra, ForcesAreTheEnergysGradientAndTheStiffnessTheForcesDerivative)
   // Central differences with step d: errors of d^2 times the third derivative, ~1e-8 relative here.
   NodeArray rest;
   std::mt19937 random(7);
-  for (const double nu : { 0.0, 0.3, 0.49 })
+  for (const Material& material : kMaterials)
   {
-    const Tetrahedron tet = irregularTetrahedron(rest, nu);
+    const Tetrahedron tet = irregularTetrahedron(rest, material);
     Model model;
     model.tetrahedra.push_back(tet);
     for (const Matrix3& F : deformations())
@@ -161,14 +205,15 @@ TEST(Tetrahedra, ForcesAreTheEnergysGradientAndTheStiffnessTheForcesDerivative)
           plus(r, a) += d;
           minus(r, a) -= d;
           EXPECT_NEAR(-(tetEnergy(tet, plus) - tetEnergy(tet, minus)) / (2.0 * d), force(r, a), 1e-6 * force.norm() + 1e-9)
-              << "nu = " << nu << ", F =\n" << F;
+              << "nu = " << material.nu << ", p0 = " << material.pressure << ", F =\n" << F;
           NodeArray f_plus = NodeArray::Zero(3, 4), f_minus = NodeArray::Zero(3, 4);
           accumulateTetForces(model, plus, f_plus);
           accumulateTetForces(model, minus, f_minus);
           const NodeArray column = -(f_plus - f_minus) / (2.0 * d);
           numeric.col(3 * a + r) = Eigen::Map<const Eigen::Matrix<double, 12, 1>>(column.data());
         }
-      EXPECT_LT((K - numeric).norm(), 1e-6 * K.norm()) << "nu = " << nu << ", F =\n" << F;
+      EXPECT_LT((K - numeric).norm(), 1e-6 * K.norm())
+          << "nu = " << material.nu << ", p0 = " << material.pressure << ", F =\n" << F;
       // A translation moves no force: every block row sums to zero.
       for (int a = 0; a < 4; ++a)
         EXPECT_LT((K.block<3, 3>(3 * a, 0) + K.block<3, 3>(3 * a, 3) + K.block<3, 3>(3 * a, 6) + K.block<3, 3>(3 * a, 9)).norm(),
@@ -181,9 +226,9 @@ TEST(Tetrahedra, TheProjectedStressDerivativeIsTheExactOnesEigenvaluesClampedAtZ
 {
   // Brute force: the exact 9x9 dP/dF decomposed numerically, its negative eigenvalues set to 0.
   NodeArray rest;
-  for (const double nu : { 0.0, 0.3, 0.49 })
+  for (const Material& material : kMaterials)
   {
-    const Tetrahedron tet = irregularTetrahedron(rest, nu);
+    const Tetrahedron tet = irregularTetrahedron(rest, material);
     int indefinite = 0;
     for (const Matrix3& F : deformations())
     {
@@ -192,10 +237,11 @@ TEST(Tetrahedra, TheProjectedStressDerivativeIsTheExactOnesEigenvaluesClampedAtZ
       indefinite += eigen.eigenvalues().minCoeff() < -1e-9 * tet.mu;
       const StressDerivative clamped =
           eigen.eigenvectors() * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * eigen.eigenvectors().transpose();
-      EXPECT_LT((stressDerivative(tet, F, true) - clamped).norm(), 1e-9 * exact.norm()) << "nu = " << nu << ", F =\n" << F;
+      EXPECT_LT((stressDerivative(tet, F, true) - clamped).norm(), 1e-9 * exact.norm())
+          << "nu = " << material.nu << ", p0 = " << material.pressure << ", F =\n" << F;
     }
     // The cases include indefinite ones (compressed, flat, inverted), where the projection changes something.
-    EXPECT_GE(indefinite, 3) << "nu = " << nu;
+    EXPECT_GE(indefinite, 3) << "nu = " << material.nu << ", p0 = " << material.pressure;
   }
 }
 
@@ -203,14 +249,18 @@ TEST(Tetrahedra, TheProjectedStiffnessIsPositiveSemiDefiniteEvenInverted)
 {
   NodeArray rest;
   std::mt19937 random(3);
-  const Tetrahedron tet = irregularTetrahedron(rest, 0.49);
-  for (const Matrix3& F : deformations())
+  for (const Material& material : { kMaterials[2], kMaterials[3] })
   {
-    Eigen::Matrix<double, 3, 4> f;
-    TetStiffness k;
-    tetForcesAndStiffness(tet, deformed(rest, F, 1e-3, random), true, f, k);
-    const Matrix12 K = assembled(k);
-    EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix12>(K).eigenvalues().minCoeff(), -1e-9 * K.norm()) << F;
+    const Tetrahedron tet = irregularTetrahedron(rest, material);
+    for (const Matrix3& F : deformations())
+    {
+      Eigen::Matrix<double, 3, 4> f;
+      TetStiffness k;
+      tetForcesAndStiffness(tet, deformed(rest, F, 1e-3, random), true, f, k);
+      const Matrix12 K = assembled(k);
+      EXPECT_GE(Eigen::SelfAdjointEigenSolver<Matrix12>(K).eigenvalues().minCoeff(), -1e-9 * K.norm())
+          << "p0 = " << material.pressure << ", F =\n" << F;
+    }
   }
 }
 

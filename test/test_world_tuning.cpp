@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "soft_body_sim/core/bodies/rope.h"
+#include "soft_body_sim/core/bodies/volume.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test
@@ -146,6 +147,35 @@ TEST(BodyScaling, ConstraintsAndCellsScaleOnlyInTheirOwnBody)
   EXPECT_EQ(world.model().constraints[1].compliance, 0.0025);
   EXPECT_EQ(world.model().cells[0].pressure, 10.0);
   EXPECT_EQ(world.model().cells[1].pressure, 30.0);
+}
+
+TEST(BodyScaling, AVolumesModuliAndGasScaleOnlyInItsOwnBody)
+{
+  // Two 2 cm cubes of E = 1e4 Pa, nu = 0.25 (mu = lambda = 4000 Pa), gas 1000 Pa; only b is scaled.
+  SceneDef scene = oneBodyScene(IntegratorType::ImplicitEuler, 1e-3);
+  VolumeDef cube;
+  cube.size = Vec3(0.02, 0.02, 0.02);
+  cube.resolution = 0.02;
+  cube.youngs_modulus = 1.0e4;
+  cube.poisson_ratio = 0.25;
+  cube.density = 100.0;
+  cube.pressure = 1000.0;
+  scene.bodies[0] = buildVolume("a", cube);
+  cube.position = Vec3(0.1, 0.0, 0.0);
+  scene.bodies.push_back(buildVolume("b", cube));
+  World world = buildWorld(scene);
+  ASSERT_TRUE(world.setBodyScaling("b", BodyScaling{ 2.0, 1.0, 3.0 }));
+  int in_b = 0;
+  for (const Tetrahedron& tet : world.model().tetrahedra)
+  {
+    const bool scaled = world.model().bodyOf(tet.nodes[0]) == 1;
+    in_b += scaled;
+    EXPECT_NEAR(tet.mu, scaled ? 8000.0 : 4000.0, 1e-9);
+    EXPECT_NEAR(tet.lambda, scaled ? 8000.0 : 4000.0, 1e-9);
+    EXPECT_EQ(tet.pressure, scaled ? 3000.0 : 1000.0);
+  }
+  EXPECT_GT(in_b, 0);
+  EXPECT_LT(in_b, static_cast<int>(world.model().tetrahedra.size()));
 }
 
 TEST(AnchorPath, AnAnchorFollowingACircleIsOnItAtTheEndOfEveryStep)

@@ -37,21 +37,24 @@ double cellArea(const PressureCell& cell, const NodeArray& x, Vec3* gradient)
   return 0.5 * cell.normal.dot(diagonal_02.cross(diagonal_13));
 }
 
+BoyleGas boyleGas(double a)
+{
+  if (a >= kCellBarrierArea)
+    return { a - 1.0 - std::log(a), 1.0 - 1.0 / a, 1.0 / (a * a) };
+  const double a_c = kCellBarrierArea;
+  const double slope = 1.0 - 1.0 / a_c;        // E'(a_c), < 0
+  const double curvature = 1.0 / (a_c * a_c);  // E''(a_c)
+  const double da = a - a_c;
+  return { (a_c - 1.0 - std::log(a_c)) + slope * da + 0.5 * curvature * da * da, slope + curvature * da, curvature };
+}
+
 CellGas cellGas(const PressureCell& cell, double area)
 {
   if (!(cell.rest_area > 0.0) || !(cell.pressure > 0.0))
     return { 0.0, 0.0, 0.0 };  // no gas (buildWorld never makes such a cell)
   const double p0 = cell.pressure;
-  const double a = area / cell.rest_area;
-  if (a >= kCellBarrierArea)
-    return { p0 * cell.rest_area * (a - 1.0 - std::log(a)), p0 * (1.0 / a - 1.0), p0 / (cell.rest_area * a * a) };
-  // E(a) = E(a_c) + E'(a_c) (a - a_c) + 1/2 E''(a_c) (a - a_c)^2, in units of p0 A0.
-  const double a_c = kCellBarrierArea;
-  const double slope = 1.0 - 1.0 / a_c;     // dE/da at a_c, < 0
-  const double curvature = 1.0 / (a_c * a_c);  // d2E/da2 at a_c
-  const double da = a - a_c;
-  const double energy = (a_c - 1.0 - std::log(a_c)) + slope * da + 0.5 * curvature * da * da;
-  return { p0 * cell.rest_area * energy, -p0 * (slope + curvature * da), p0 * curvature / cell.rest_area };
+  const BoyleGas gas = boyleGas(area / cell.rest_area);
+  return { p0 * cell.rest_area * gas.energy, -p0 * gas.slope, p0 * gas.curvature / cell.rest_area };
 }
 
 void accumulatePressureForces(const Model& model, const NodeArray& x, NodeArray& force)

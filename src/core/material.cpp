@@ -55,12 +55,14 @@ void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& sca
       model.rods[k].twisting_stiffness = built_rods_[k].twisting_stiffness * scaling.stiffness;
       model.rods[k].damping = built_rods_[k].damping * scaling.damping;
     }
-  // A solid's Lame parameters scale with its Young's modulus (its Poisson's ratio kept).
+  // A solid's Lame parameters scale with its Young's modulus (its Poisson's ratio kept), its gas's
+  // pressure as a jelly cell's.
   for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
     if (model.bodyOf(built_tetrahedra_[k].nodes[0]) == body)
     {
       model.tetrahedra[k].mu = built_tetrahedra_[k].mu * scaling.stiffness;
       model.tetrahedra[k].lambda = built_tetrahedra_[k].lambda * scaling.stiffness;
+      model.tetrahedra[k].pressure = built_tetrahedra_[k].pressure * scaling.pressure;
     }
 }
 

@@ -8,6 +8,8 @@
 #include <Eigen/LU>
 #include <Eigen/SVD>
 
+#include "soft_body_sim/core/forces.h"
+
 namespace soft_body_sim
 {
 namespace
@@ -43,8 +45,27 @@ Eigen::Matrix<double, 3, 4> shapeGradients(const Tetrahedron& tet)
   return g;
 }
 
-/// lambda' = lambda + mu (see tetrahedra.h).
-double volumeModulus(const Tetrahedron& tet) { return tet.lambda + tet.mu; }
+/// The part of Psi that depends on J alone, f(J) = -mu (J - 1) + lambda' / 2 (J - 1)^2 + p0 E(J) (E of
+/// boyleGas, lambda' = lambda + mu; see tetrahedra.h), and its first two derivatives.
+struct VolumeTerm
+{
+  double energy;     ///< f(J) [Pa]
+  double slope;      ///< f'(J) [Pa]: the factor of cof F in P, and of J's Hessian in dP/dF
+  double curvature;  ///< f''(J) [Pa]: the factor of cof F cof F^T in dP/dF
+};
+VolumeTerm volumeTerm(const Tetrahedron& tet, double J)
+{
+  const double lambda = tet.lambda + tet.mu;
+  VolumeTerm term{ -tet.mu * (J - 1.0) + 0.5 * lambda * (J - 1.0) * (J - 1.0), lambda * (J - 1.0) - tet.mu, lambda };
+  if (tet.pressure > 0.0)
+  {
+    const BoyleGas gas = boyleGas(J);
+    term.energy += tet.pressure * gas.energy;
+    term.slope += tet.pressure * gas.slope;
+    term.curvature += tet.pressure * gas.curvature;
+  }
+  return term;
+}
 
 /// vec(U M V^T), column-major: the mode of F-space that M is in the frame of the SVD (U, V).
 Vector9 mode(const Matrix3& U, const Matrix3& V, const Matrix3& M)
@@ -91,28 +112,26 @@ Matrix3 deformationGradient(const Tetrahedron& tet, const NodeArray& x)
 
 double strainEnergyDensity(const Tetrahedron& tet, const Matrix3& F)
 {
-  const double J = F.determinant();
-  return 0.5 * tet.mu * (F.squaredNorm() - 3.0) - tet.mu * (J - 1.0) + 0.5 * volumeModulus(tet) * (J - 1.0) * (J - 1.0);
+  return 0.5 * tet.mu * (F.squaredNorm() - 3.0) + volumeTerm(tet, F.determinant()).energy;
 }
 
 Matrix3 firstPiolaStress(const Tetrahedron& tet, const Matrix3& F)
 {
-  const double J = F.determinant();
-  return tet.mu * F + (volumeModulus(tet) * (J - 1.0) - tet.mu) * cofactor(F);
+  return tet.mu * F + volumeTerm(tet, F.determinant()).slope * cofactor(F);
 }
 
 StressDerivative stressDerivative(const Tetrahedron& tet, const Matrix3& F, bool project)
 {
-  const double J = F.determinant();
-  const double lambda = volumeModulus(tet);
-  const double s = lambda * (J - 1.0) - tet.mu;  // the factor of J's Hessian
+  const VolumeTerm term = volumeTerm(tet, F.determinant());
+  const double c = term.curvature;  // f''(J): lambda' without gas
+  const double s = term.slope;      // f'(J), the factor of J's Hessian
   StressDerivative H;
   if (!project)
   {
-    // mu I + lambda' g g^T + s d(cof F)/dF, its 3x3 blocks d(cof_i)/d(f_j) (cof_0 = f1 x f2, ...).
+    // mu I + c g g^T + s d(cof F)/dF, its 3x3 blocks d(cof_i)/d(f_j) (cof_0 = f1 x f2, ...).
     const Matrix3 cof = cofactor(F);
     const Vector9 g = Eigen::Map<const Vector9>(cof.data());
-    H = tet.mu * StressDerivative::Identity() + lambda * g * g.transpose();
+    H = tet.mu * StressDerivative::Identity() + c * g * g.transpose();
     const Matrix3 h0 = s * crossMatrix(F.col(0)), h1 = s * crossMatrix(F.col(1)), h2 = s * crossMatrix(F.col(2));
     H.block<3, 3>(0, 3) -= h2;
     H.block<3, 3>(0, 6) += h1;
@@ -160,9 +179,9 @@ StressDerivative stressDerivative(const Tetrahedron& tet, const Matrix3& F, bool
       H.noalias() += flip_value * q * q.transpose();
     }
   }
-  // Scaling modes: mu |d|^2 + lambda' (pi . d)^2 + 2 s sum_{i<j} sigma_k d_i d_j on d = D's diagonal.
+  // Scaling modes: mu |d|^2 + c (pi . d)^2 + 2 s sum_{i<j} sigma_k d_i d_j on d = D's diagonal.
   const Vec3 pi(sigma[1] * sigma[2], sigma[2] * sigma[0], sigma[0] * sigma[1]);
-  Matrix3 A = tet.mu * Matrix3::Identity() + lambda * pi * pi.transpose();
+  Matrix3 A = tet.mu * Matrix3::Identity() + c * pi * pi.transpose();
   for (int k = 0; k < 3; ++k)
   {
     const int i = (k + 1) % 3, j = (k + 2) % 3;

@@ -31,8 +31,22 @@ inline double springTension(const Spring& s, const Vec3& u, double length, const
 /// Adds every spring's Hooke + dashpot force [N] to `force` (see Spring).
 void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force);
 
-/// Below this fraction a = A / A0 of its rest area a cell's gas law continues as a parabola (see CellGas).
+/// Below this fraction a of its rest area (a cell) or volume (a tetrahedron) a gas's law continues as a
+/// parabola (see BoyleGas).
 constexpr double kCellBarrierArea = 0.1;
+
+/// Boyle's law in an atmosphere of the rest pressure, per p0 and rest measure (area or volume) A0: at
+/// a = A / A0 the gas's energy is p0 A0 E(a), its net pressure -p0 E'(a), with
+///   a >= a_c:  E = a - 1 - ln a,   E' = 1 - 1/a,   E'' = 1 / a^2
+///   a <  a_c:  the second-order Taylor continuation of E about a_c = kCellBarrierArea (C2 joint).
+/// A jelly cell's gas (CellGas) and a volume's per-tetrahedron gas (tetrahedra.h) both follow it.
+struct BoyleGas
+{
+  double energy;     ///< E(a) [-]
+  double slope;      ///< E'(a), < 0 compressed: minus the net pressure per p0
+  double curvature;  ///< E''(a), > 0
+};
+BoyleGas boyleGas(double a);
 
 /// Signed area A [m^2] of a pressure cell (see PressureCell), the diagonal form of the shoelace formula:
 ///   A = 1/2 n . ((x_2 - x_0) x (x_3 - x_1)),

@@ -112,6 +112,7 @@ struct Tetrahedron
   double rest_volume = 0.0;  ///< V0 = det(D_m) / 6 [m^3], > 0
   double mu = 0.0;           ///< Lame's second parameter, the shear modulus E / (2 (1 + nu)) [Pa], > 0
   double lambda = 0.0;       ///< Lame's first parameter E nu / ((1 + nu)(1 - 2 nu)) [Pa], >= 0
+  double pressure = 0.0;     ///< p0 [Pa] of the gas it holds (tetrahedra.h), >= 0; 0: no gas
 };
 
 /// A named run of consecutive nodes: the scene's bodies share one node array.

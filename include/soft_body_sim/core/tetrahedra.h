@@ -13,6 +13,14 @@
 // with its Hessian projected onto the positive semi-definite matrices per tetrahedron by the analytic
 // eigen-system of Smith et al. (tetStiffness), so the system stays symmetric positive definite at any
 // strain, inverted tetrahedra included.
+//
+// Gas (a volume's `pressure` p0 > 0): each tetrahedron holds an ideal gas at rest pressure p0 in an
+// atmosphere of p0, Boyle's law as in a jelly cell (forces.h's BoyleGas), so that Psi gains p0 E(J),
+// E(J) = J - 1 - ln J: net pressure p0 (1/J - 1), bulk modulus p0 at small strain (an isothermal ideal
+// gas's), and a barrier that grows without bound as a tetrahedron is squeezed flat (the jelly seed's
+// pressure "that prevents it from collapsing", per element, in 3D: a closed-cell foam). Psi's J-part is
+// then f(J) = -mu (J - 1) + lambda' / 2 (J - 1)^2 + p0 E(J), and the stress and eigen-system below hold
+// with s = f'(J) and lambda' replaced by f''(J).
 #pragma once
 
 #include <array>
@@ -43,7 +51,8 @@ Eigen::Matrix3d deformationGradient(const Tetrahedron& tet, const NodeArray& x);
 /// Psi(F) [Pa = J/m^3] of `tet`'s material.
 double strainEnergyDensity(const Tetrahedron& tet, const Eigen::Matrix3d& F);
 
-/// The first Piola-Kirchhoff stress P = dPsi/dF = mu F + (lambda' (J - 1) - mu) cof F [Pa],
+/// The first Piola-Kirchhoff stress P = dPsi/dF = mu F + f'(J) cof F [Pa], f'(J) = lambda' (J - 1) - mu
+/// (+ p0 (1 - 1/J) with gas),
 /// cof F = dJ/dF = [f1 x f2, f2 x f0, f0 x f1] (f_i F's columns).
 Eigen::Matrix3d firstPiolaStress(const Tetrahedron& tet, const Eigen::Matrix3d& F);
 
@@ -51,8 +60,8 @@ Eigen::Matrix3d firstPiolaStress(const Tetrahedron& tet, const Eigen::Matrix3d& 
 /// semi-definite matrices (its negative eigenvalues set to 0) by the analytic eigen-system of Smith et al.
 /// 2018: in the rotation-variant SVD F = U S V^T (U, V rotations, S's last entry negative when F inverts)
 /// the six twist and flip modes U (e_i e_j^T -+ e_j e_i^T) V^T / sqrt 2 have eigenvalues
-/// mu +- s sigma_k (s = lambda' (J - 1) - mu, k the third index), and the three scaling modes U diag(w) V^T
-/// a 3x3 matrix mu I + lambda' pi pi^T + s [sigma_k off its diagonal] (pi_i = J / sigma_i).
+/// mu +- s sigma_k (s = f'(J), k the third index), and the three scaling modes U diag(w) V^T a 3x3 matrix
+/// mu I + f''(J) pi pi^T + s [sigma_k off its diagonal] (pi_i = J / sigma_i).
 using StressDerivative = Eigen::Matrix<double, 9, 9>;
 StressDerivative stressDerivative(const Tetrahedron& tet, const Eigen::Matrix3d& F, bool project);
 

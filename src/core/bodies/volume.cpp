@@ -102,9 +102,8 @@ BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
                     "poisson_ratio must be in [0, 0.5) (0.5 is incompressible: no finite Lame lambda)");
   requireDefinition(volume.density > 0.0 && std::isfinite(volume.density), what, { "density" },
                     "density must be > 0 [kg/m^3]");
-  // Honest about the physics: tetrahedra.h has no gas term yet, so a pressure would be silently ignored.
-  requireDefinition(volume.pressure == 0.0, what, { "pressure" },
-                    "the gas pressure inside a volume is not supported yet; only pressure 0 is accepted");
+  requireDefinition(volume.pressure >= 0.0 && std::isfinite(volume.pressure), what, { "pressure" },
+                    "pressure must be >= 0 [Pa] (the rest pressure of the gas each tetrahedron holds; 0: no gas)");
   std::vector<const BoxFace*> faces;
   for (const std::string& face_name : volume.pinned_faces)
   {
@@ -135,7 +134,8 @@ BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
   body.tetrahedra.reserve(mesh.tets.size());
   for (const std::array<int, 4>& t : mesh.tets)
   {
-    const Tetrahedron tet = makeTetrahedron(t, rest, lame);
+    Tetrahedron tet = makeTetrahedron(t, rest, lame);
+    tet.pressure = volume.pressure;
     // Lumped masses: a linear tetrahedron's consistent mass matrix rho V (1 + delta_ab) / 20 summed over
     // each row gives rho V / 4 to each of its nodes.
     for (int node : t)

@@ -36,7 +36,7 @@ struct VolumeDef
   std::vector<std::string> pinned_faces;  ///< box only: every node on these faces is pinned: x_min,
                                           ///< x_max, y_min, y_max, z_min, z_max
   std::vector<int> pinned_nodes;   ///< node indices (negative from the end) pinned
-  /// [Pa] the gas pressure inside. Only 0 is accepted: the gas term of a volume is not in the physics yet.
+  /// [Pa] the rest pressure p0 of the gas each tetrahedron holds (tetrahedra.h), >= 0; 0: no gas.
   double pressure = 0.0;
 };
 
