@@ -1632,6 +1632,8 @@ TEST(SceneLoader, AVolumesMistakesAreNamedAtTheirKeys)
                    { "out of range" });
   expectSceneError("bodies:\n  - " + box + ", pressure: -1000}\n", "bad.yaml:2: bodies[0].pressure",
                    { ">= 0 [Pa]" });
+  expectSceneError("bodies:\n  - " + box + ", friction: -0.5}\n", "bad.yaml:2: bodies[0].friction",
+                   { "friction must be >= 0" });
   expectSceneError("bodies:\n  - {name: s, type: volume, resolution: 0.02, position: [0, 0, 1], "
                    "youngs_modulus: 5e4, density: 100, shape: box}\n",
                    "bad.yaml:2: bodies[0].shape", { "needs size" });

@@ -208,8 +208,11 @@ World buildWorld(const SceneDef& scene)
     }
     if (body.controller)
       controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });
-    requireSelfContact("body '" + body.name + "'", body.self_collision, body.self_friction, body.contact_radius,
-                       "contact_radius");
+    // A solid's self_friction is its surface's friction against other bodies (surface_contacts.h), its
+    // builder's check; it has no self-collision.
+    if (body.tetrahedra.empty())
+      requireSelfContact("body '" + body.name + "'", body.self_collision, body.self_friction, body.contact_radius,
+                         "contact_radius");
     model.bodies.push_back(
         { body.name, first, count, body.self_collision, body.self_friction, body.springs_collide, std::move(surface) });
     first += count;

@@ -122,7 +122,9 @@ struct BodyRange
   int first = 0;
   int count = 0;
   bool self_collision = false;  ///< its links keep apart by their radii (self_contacts.h)
-  double self_friction = 0.0;   ///< Coulomb coefficient [-] where they touch (self_contacts.h)
+  /// Coulomb coefficient [-] where they touch (self_contacts.h); a solid's: its surface's against other
+  /// bodies (surface_contacts.h)
+  double self_friction = 0.0;
   bool springs_collide = false; ///< its springs too keep its own nodes out (a jelly; self_contacts.h)
   /// A solid's boundary (a `type: volume` body): triangles of global node indices, counter-clockwise seen
   /// from outside; empty for every other body.

@@ -102,6 +102,8 @@ BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
                     "poisson_ratio must be in [0, 0.5) (0.5 is incompressible: no finite Lame lambda)");
   requireDefinition(volume.density > 0.0 && std::isfinite(volume.density), what, { "density" },
                     "density must be > 0 [kg/m^3]");
+  requireDefinition(volume.friction >= 0.0 && std::isfinite(volume.friction), what, { "friction" },
+                    "friction must be >= 0 (a Coulomb coefficient)");
   requireDefinition(volume.pressure >= 0.0 && std::isfinite(volume.pressure), what, { "pressure" },
                     "pressure must be >= 0 [Pa] (the rest pressure of the gas each tetrahedron holds; 0: no gas)");
   std::vector<const BoxFace*> faces;
@@ -122,6 +124,7 @@ BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
   body.name = name;
   body.type = "volume";
   body.contact_radius = 0.0;  // its nodes are its contact points
+  body.self_friction = volume.friction;  // its surface's, against other bodies (surface_contacts.h)
   for (const Eigen::Vector3d& node : mesh.nodes)
     body.nodes.push_back(NodeDef{ node + volume.position, 0.0, Vec3::Zero(), false });
 

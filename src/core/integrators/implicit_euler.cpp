@@ -1,7 +1,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <optional>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -12,6 +15,7 @@
 #include "sparse_block_solver.h"
 #include "soft_body_sim/core/forces.h"
 #include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/surface_contacts.h"
 #include "soft_body_sim/core/tetrahedra.h"
 
 namespace soft_body_sim
@@ -54,6 +58,9 @@ using Matrix3 = Eigen::Matrix3d;
 /// node pairs couple) depends only on the elements and which nodes are pinned: it is analysed
 /// on the first step and after every model change, and each Newton iteration only writes its values and
 /// factorises. Every array is sized once: a step allocates nothing after the first.
+/// Other bodies' nodes touching a solid's surface are held on it in the same solve (addSurfaceHolds), their
+/// blocks coupling a node to a triangle's three: those lie outside the analysed pattern, so a step with any
+/// solves by conjugate gradients preconditioned by the factorisation without them (or block Jacobi).
 class ImplicitEuler final : public ForceBasedIntegrator
 {
 public:
@@ -98,11 +105,10 @@ public:
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
           state.velocity.col(i) += delta_v_.col(i);
-      if (contacts_ != nullptr && k + 1 < iterations)
+      if (k + 1 < iterations)
         letGoPullingHolds(h);
     }
-    if (contacts_ != nullptr)
-      noteHoldForces(h);
+    noteHoldForces(h);
     for (int i = 0; i < n; ++i)
       if (model.isFree(i))
         state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
@@ -242,6 +248,121 @@ private:
       addTetrahedra(model, x, h);
     if (contacts_ != nullptr)
       addSolidContacts(model, x, v, h, first_iteration);
+    if (surface_contacts_ != nullptr)
+      addSurfaceHolds(model, x, v, h, first_iteration);
+  }
+
+  /// A node of another body held on a solid's boundary triangle in the solve (addSurfaceHolds).
+  struct SurfaceHold
+  {
+    SurfaceTouch touch;  ///< as found at the step's first Newton iteration (node p, triangle, weights, n)
+    int nodes[4];        ///< p, then the triangle's three nodes, each -1 where pinned
+    double weights[4];   ///< 1, -w_0, -w_1, -w_2: the gap x_p - q = sum_l weights_l x_l
+    Vec3 found_gap;      ///< [m] the gap at the predicted positions where it was found
+    double depth;        ///< d [m] at this iteration's predicted positions
+    double scaled;       ///< h^2 k [kg] in this iteration
+    Matrix3 block;       ///< B = h^2 k n n^T + h c (I - n n^T); A gains weights_l weights_m B on (l, m)
+  };
+
+  /// The surface holds of a step: as a solid's node is held on a collider (addSolidContacts), a node p of
+  /// another body (a rope's, a cloth's, another solid's) whose predicted position lies within its contact
+  /// radius of a solid's boundary triangle, or behind it (SurfaceContacts::find), or within |g| h^2 of
+  /// that unless its hold pulled in the last step, is held by a one-sided spring on the gap
+  /// g = n . (x_p - q) - r_p, q = sum_k w_k x_k the triangle's nearest point at weights w: the Jacobian of
+  /// g is weights_l n^T on the four nodes, so the node and the triangle's nodes push each other apart with
+  /// equal and opposite forces (momentum kept) and A gains h^2 k weights_l weights_m n n^T. k is
+  /// kContactStiffness times the contact's effective mass b = 1 / sum_l weights_l^2 / b_l (b_l the free
+  /// nodes' diagonal means): the solve leaves about 1 / kContactStiffness of the depth. Coulomb friction
+  /// damps their relative velocity across n as on a collider, pressed by max(b d / h^2, the hold's force
+  /// in the last step), the solid's `friction` (two solids': the mean).
+  void addSurfaceHolds(const Model& model, const NodeArray& x, const NodeArray& v, double h, bool first_iteration)
+  {
+    if (first_iteration)
+      findSurfaceHolds(model, x, h);
+    for (SurfaceHold& c : surface_holds_)
+    {
+      const Vec3& n = c.touch.normal;
+      Vec3 gap = Vec3::Zero(), relative = Vec3::Zero();
+      double inverse_block = 0.0;
+      const int all[4] = { c.touch.node, c.touch.triangle[0], c.touch.triangle[1], c.touch.triangle[2] };
+      for (int l = 0; l < 4; ++l)
+      {
+        gap += c.weights[l] * (x.col(all[l]) + offset_.col(all[l]));
+        relative += c.weights[l] * v.col(all[l]);
+        if (c.nodes[l] >= 0)
+          inverse_block += c.weights[l] * c.weights[l] / (diagonal_[static_cast<std::size_t>(c.nodes[l])].trace() / 3.0);
+      }
+      c.depth = c.touch.depth - n.dot(gap - c.found_gap);
+      c.scaled = 0.0;
+      c.block.setZero();
+      if (!(inverse_block > 0.0))
+        continue;  // all four pinned
+      const double block = 1.0 / inverse_block;  // b [kg]
+      c.scaled = kContactStiffness * block;
+      Vec3 push = (c.scaled / h * c.depth) * n;
+      c.block = c.scaled * (n * n.transpose());
+      const double normal_force =
+          std::max(block * c.depth / (h * h), surface_hold_force_[static_cast<std::size_t>(c.touch.node)]);
+      if (c.touch.friction > 0.0 && normal_force > 0.0)
+      {
+        const Vec3 tangential = relative - relative.dot(n) * n;
+        const double damping = c.touch.friction * normal_force / std::max(tangential.norm(), kStickSpeed);
+        push -= h * damping * tangential;
+        c.block += h * damping * (Matrix3::Identity() - n * n.transpose());
+      }
+      for (int l = 0; l < 4; ++l)
+        if (c.nodes[l] >= 0)
+          rhs_.col(c.nodes[l]) += c.weights[l] * push;
+    }
+  }
+
+  /// The surface holds of a step (addSurfaceHolds), found at its first Newton iteration and kept through the
+  /// others.
+  void findSurfaceHolds(const Model& model, const NodeArray& x, double h)
+  {
+    const double margin = model.gravity.norm() * h * h;
+    const double widest = model.contact_radius.size() > 0 ? model.contact_radius.maxCoeff() : 0.0;
+    predicted_ = x + offset_;
+    surface_contacts_->find(model, x, predicted_, std::max(margin, 0.5 * widest), touches_);
+    surface_holds_.clear();
+    for (const SurfaceTouch& touch : touches_)
+    {
+      // A hold that pushed in the last step is kept while the node stays within half its radius (or |g| h^2)
+      // of the surface: released as soon as the push has set it moving off, it would fall back in the next
+      // step and be pushed out again, a bounce every other step (seen at 1/240 s on a rope over an edge).
+      const double keep = std::max(margin, 0.5 * model.contact_radius[touch.node]);
+      if (touch.depth <= (surface_hold_force_[static_cast<std::size_t>(touch.node)] > 0.0 ? -keep : 0.0))
+        continue;
+      SurfaceHold c;
+      c.touch = touch;
+      const int all[4] = { touch.node, touch.triangle[0], touch.triangle[1], touch.triangle[2] };
+      c.weights[0] = 1.0;
+      c.found_gap = predicted_.col(touch.node);
+      for (int l = 0; l < 4; ++l)
+      {
+        if (l > 0)
+        {
+          c.weights[l] = -touch.weight[l - 1];
+          c.found_gap += c.weights[l] * predicted_.col(all[l]);
+        }
+        c.nodes[l] = model.isFree(all[l]) ? all[l] : -1;
+      }
+      c.depth = touch.depth;
+      c.scaled = 0.0;
+      c.block.setZero();
+      surface_holds_.push_back(c);
+    }
+  }
+
+  /// k (d - h n . sum_l weights_l dv_l) [N]: the force surface hold `c` took in the Newton iteration just
+  /// solved (> 0 pushing).
+  double holdForce(const SurfaceHold& c, double h) const
+  {
+    Vec3 dv = Vec3::Zero();
+    for (int l = 0; l < 4; ++l)
+      if (c.nodes[l] >= 0)
+        dv += c.weights[l] * delta_v_.col(c.nodes[l]);
+    return c.scaled / (h * h) * (c.depth - h * c.touch.normal.dot(dv));
   }
 
   /// A solid's node held on a collider's surface in the solve (addSolidContacts).
@@ -333,9 +454,14 @@ private:
   /// would be pressed onto the first, its tetrahedra flat).
   void letGoPullingHolds(double h)
   {
-    solid_contacts_.erase(std::remove_if(solid_contacts_.begin(), solid_contacts_.end(),
-                                         [&](const SolidContact& c) { return holdForce(c, h) < 0.0; }),
-                          solid_contacts_.end());
+    if (contacts_ != nullptr)
+      solid_contacts_.erase(std::remove_if(solid_contacts_.begin(), solid_contacts_.end(),
+                                           [&](const SolidContact& c) { return holdForce(c, h) < 0.0; }),
+                            solid_contacts_.end());
+    if (surface_contacts_ != nullptr)
+      surface_holds_.erase(std::remove_if(surface_holds_.begin(), surface_holds_.end(),
+                                          [&](const SurfaceHold& c) { return holdForce(c, h) < 0.0; }),
+                           surface_holds_.end());
   }
 
   /// The force each hold of the last Newton iteration took, k (d - h n . dv) at its node's new depth: where
@@ -345,9 +471,18 @@ private:
   /// weight). Every other solid node may be held again, with no force known.
   void noteHoldForces(double h)
   {
-    std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
-    for (const SolidContact& c : solid_contacts_)
-      hold_force_[static_cast<std::size_t>(c.node)] = holdForce(c, h);
+    if (contacts_ != nullptr)
+    {
+      std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
+      for (const SolidContact& c : solid_contacts_)
+        hold_force_[static_cast<std::size_t>(c.node)] = holdForce(c, h);
+    }
+    if (surface_contacts_ != nullptr)
+    {
+      std::fill(surface_hold_force_.begin(), surface_hold_force_.end(), 0.0);
+      for (const SurfaceHold& c : surface_holds_)
+        surface_hold_force_[static_cast<std::size_t>(c.touch.node)] = holdForce(c, h);
+    }
   }
 
   /// [m/s] below this tangential speed a solid's contact sticks (its friction's damping no longer grows).
@@ -460,6 +595,10 @@ private:
       for (int c = 0; c < 4; ++c)
         preconditioner_[static_cast<std::size_t>(model.cells[k].nodes[c])] +=
             cells_[k].scale * cells_[k].g[c] * cells_[k].g[c].transpose();
+    for (const SurfaceHold& c : surface_holds_)
+      for (int l = 0; l < 4; ++l)
+        if (c.nodes[l] >= 0)
+          preconditioner_[static_cast<std::size_t>(c.nodes[l])] += (c.weights[l] * c.weights[l]) * c.block;
     for (int i = 0; i < n; ++i)
     {
       Matrix3& p = preconditioner_[static_cast<std::size_t>(i)];
@@ -536,6 +675,18 @@ private:
         out.col(a) += k_ab * p.col(b);
         out.col(b) += k_ab.transpose() * p.col(a);
       }
+    // The surface holds' blocks in full, their diagonal ones too (they are not in diagonal_).
+    for (const SurfaceHold& c : surface_holds_)
+    {
+      Vec3 gap = Vec3::Zero();
+      for (int l = 0; l < 4; ++l)
+        if (c.nodes[l] >= 0)
+          gap += c.weights[l] * p.col(c.nodes[l]);
+      const Vec3 pushed = c.block * gap;
+      for (int l = 0; l < 4; ++l)
+        if (c.nodes[l] >= 0)
+          out.col(c.nodes[l]) += c.weights[l] * pushed;
+    }
   }
 
   void precondition(const NodeArray& r, NodeArray& z) const
@@ -589,10 +740,11 @@ private:
   static constexpr double kTolerance = 1e-12;
 
   /// The node pairs whose blocks of A may be non-zero, one slot each: every spring with both ends free,
-  /// then every pair of free corners of every cell (six per cell, in kCellPairs' order).
+  /// then every pair of free corners of every cell (six per cell, in kFourNodePairs' order).
   void analyze(const Model& model)
   {
-    std::vector<std::pair<int, int>> pairs;
+    std::vector<std::pair<int, int>>& pairs = pairs_;
+    pairs.clear();
     spring_slot_.assign(model.springs.size(), -1);
     for (std::size_t k = 0; k < model.springs.size(); ++k)
     {
@@ -605,9 +757,9 @@ private:
     }
     cell_slot_.assign(6 * model.cells.size(), -1);
     for (std::size_t k = 0; k < model.cells.size(); ++k)
-      for (std::size_t p = 0; p < kCellPairs.size(); ++p)
+      for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
       {
-        const int a = model.cells[k].nodes[kCellPairs[p].first], b = model.cells[k].nodes[kCellPairs[p].second];
+        const int a = model.cells[k].nodes[kFourNodePairs[p].first], b = model.cells[k].nodes[kFourNodePairs[p].second];
         if (model.isFree(a) && model.isFree(b) && a != b)
         {
           cell_slot_[6 * k + p] = static_cast<int>(pairs.size());
@@ -643,6 +795,17 @@ private:
     for (const Tetrahedron& tet : model.tetrahedra)
       for (const int node : tet.nodes)
         solid_node_[static_cast<std::size_t>(node)] = 1;
+    surface_finder_.emplace(model);
+    surface_contacts_ = model.tetrahedra.empty() || surface_finder_->empty() ? nullptr : &*surface_finder_;
+    surface_hold_force_.assign(static_cast<std::size_t>(model.nodeCount()), 0.0);
+    surface_holds_.clear();
+    if (surface_contacts_ != nullptr)
+    {
+      // A node touches at most one triangle of each solid.
+      const std::size_t most = static_cast<std::size_t>(model.nodeCount()) * model.bodies.size();
+      surface_holds_.reserve(most);
+      touches_.reserve(most);
+    }
     tet_slot_.assign(6 * model.tetrahedra.size(), -1);
     for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
       for (std::size_t p = 0; p < kTetPairs.size(); ++p)
@@ -654,11 +817,51 @@ private:
           pairs.emplace_back(a, b);
         }
       }
+    base_pairs_ = pairs.size();
+    hold_slot_.clear();
     chains_ = linear_solve_ != LinearSolve::Iterative && chain_solver_.analyze(model.nodeCount(), pairs);
     factorable_ = chains_ || (linear_solve_ != LinearSolve::Iterative &&
                               solver_.analyze(model.nodeCount(), pairs,
                                               linear_solve_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork));
     analyzed_ = true;
+  }
+
+  /// Gives every node pair of every surface hold (the node with the triangle's three, and those among
+  /// themselves) a slot of solver_ (hold_slots_, six per hold in kFourNodePairs' order, -1 where a node is
+  /// pinned). A pair not yet in the pattern has the pattern analysed again with it, the pairs of earlier
+  /// holds kept unless they are more than kKeptHoldPairs times the present holds' (then only these):
+  /// resting contact keeps its pattern from step to step, sliding contact pays an analysis when it
+  /// reaches a new triangle, and pairs of contacts long gone do not pile up.
+  void placeHoldPairs(const Model& model)
+  {
+    const auto key = [](int a, int b) {
+      return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint64_t>(std::max(a, b));
+    };
+    bool missing = false;
+    for (const SurfaceHold& c : surface_holds_)
+      for (const auto& [l, m] : kFourNodePairs)
+        missing = missing || (c.nodes[l] >= 0 && c.nodes[m] >= 0 && hold_slot_.count(key(c.nodes[l], c.nodes[m])) == 0);
+    if (missing)
+    {
+      if (pairs_.size() - base_pairs_ > kKeptHoldPairs * kFourNodePairs.size() * surface_holds_.size())
+      {
+        pairs_.resize(base_pairs_);
+        hold_slot_.clear();
+      }
+      for (const SurfaceHold& c : surface_holds_)
+        for (const auto& [l, m] : kFourNodePairs)
+          if (c.nodes[l] >= 0 && c.nodes[m] >= 0 && hold_slot_.emplace(key(c.nodes[l], c.nodes[m]), pairs_.size()).second)
+            pairs_.emplace_back(c.nodes[l], c.nodes[m]);
+      factorable_ = solver_.analyze(model.nodeCount(), pairs_,
+                                    linear_solve_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork);
+    }
+    hold_slots_.resize(kFourNodePairs.size() * surface_holds_.size());
+    for (std::size_t k = 0; k < surface_holds_.size(); ++k)
+      for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
+      {
+        const int a = surface_holds_[k].nodes[kFourNodePairs[p].first], b = surface_holds_[k].nodes[kFourNodePairs[p].second];
+        hold_slots_[kFourNodePairs.size() * k + p] = a >= 0 && b >= 0 ? static_cast<int>(hold_slot_.at(key(a, b))) : -1;
+      }
   }
 
   /// delta_v_ = A^-1 rhs_: directly, A written from the blocks of assemble into the analysed pattern (block
@@ -674,6 +877,8 @@ private:
       solveDirectly(model, chain_solver_);
       return;
     }
+    if (!surface_holds_.empty() && linear_solve_ != LinearSolve::Iterative)
+      placeHoldPairs(model);
     const bool cheaper_by_cg = linear_solve_ == LinearSolve::Cheaper &&
                                solver_.factorWork() / solver_.matrixEntries() >
                                    kDirectWorkPerRootCondition * std::sqrt(condition_);
@@ -687,7 +892,7 @@ private:
   }
 
   /// Writes A into `solver` (BlockTridiagonalSolver or SparseBlockSolver, analysed with the slots of
-  /// analyze), factorises it and solves for delta_v_.
+  /// analyze, and placeHoldPairs for surface holds), factorises it and solves for delta_v_.
   template <class Solver>
   void solveDirectly(const Model& model, Solver& solver)
   {
@@ -706,10 +911,10 @@ private:
       for (int c = 0; c < 4; ++c)
         if (model.isFree(cell.nodes[c]))
           solver.addDiagonal(cell.nodes[c], block.scale * block.g[c] * block.g[c].transpose());
-      for (std::size_t p = 0; p < kCellPairs.size(); ++p)
+      for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
         if (cell_slot_[6 * k + p] >= 0)
           solver.addOffDiagonal(static_cast<std::size_t>(cell_slot_[6 * k + p]),
-                                block.scale * block.g[kCellPairs[p].first] * block.g[kCellPairs[p].second].transpose());
+                                block.scale * block.g[kFourNodePairs[p].first] * block.g[kFourNodePairs[p].second].transpose());
     }
     for (std::size_t k = 0; k < rod_blocks_.size(); ++k)
     {
@@ -727,6 +932,18 @@ private:
     // A is symmetric positive definite by construction (the transverse stiffness of compressed springs
     // and the indefinite part of the gas's Hessian are dropped, see above), unless the state is not
     // finite: then the step is not finite either, and the divergence guard (guard.h) takes it.
+    // A surface hold's blocks weights_l weights_m B (only ever in the sparse pattern: a solid is no chain).
+    for (std::size_t k = 0; k < surface_holds_.size(); ++k)
+    {
+      const SurfaceHold& c = surface_holds_[k];
+      for (int l = 0; l < 4; ++l)
+        if (c.nodes[l] >= 0)
+          solver.addDiagonal(c.nodes[l], (c.weights[l] * c.weights[l]) * c.block);
+      for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
+        if (hold_slots_[kFourNodePairs.size() * k + p] >= 0)
+          solver.addOffDiagonal(static_cast<std::size_t>(hold_slots_[kFourNodePairs.size() * k + p]),
+                                (c.weights[kFourNodePairs[p].first] * c.weights[kFourNodePairs[p].second]) * c.block);
+    }
     if (solver.factorize())
       solver.solve(rhs_, delta_v_);
     else
@@ -751,8 +968,11 @@ private:
   static constexpr double kMaxFactorWork = 2000.0;
   static constexpr double kAnyWork = std::numeric_limits<double>::infinity();
 
-  /// The six pairs of a cell's four corners.
-  static constexpr std::array<std::pair<int, int>, 6> kCellPairs{ { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } } };
+  /// How many times the present surface holds' node pairs the pattern keeps of earlier holds' (placeHoldPairs).
+  static constexpr std::size_t kKeptHoldPairs = 4;
+
+  /// The six pairs of four nodes: a cell's corners, a surface hold's node and triangle.
+  static constexpr std::array<std::pair<int, int>, 6> kFourNodePairs{ { { 0, 1 }, { 0, 2 }, { 0, 3 }, { 1, 2 }, { 1, 3 }, { 2, 3 } } };
 
   /// The three node pairs of a rod vertex (before, at, after).
   static constexpr std::array<std::pair<int, int>, 3> kRodPairs{ { { 0, 1 }, { 0, 2 }, { 1, 2 } } };
@@ -782,12 +1002,23 @@ private:
   std::vector<int> rod_slot_;            ///< per rod vertex, three: each node pair's slot, or -1
   std::vector<TetBlock> tet_blocks_;     ///< per tetrahedron
   std::vector<int> tet_slot_;            ///< per tetrahedron, six: each node pair's slot, or -1
+  std::vector<std::pair<int, int>> pairs_;  ///< solver_'s slots: the elements' (analyze), then the holds'
+  std::size_t base_pairs_ = 0;              ///< how many of pairs_ are the elements'
+  std::unordered_map<std::uint64_t, std::size_t> hold_slot_;  ///< a surface hold's node pair -> its slot
+  std::vector<int> hold_slots_;             ///< per surface hold, six: each node pair's slot, or -1
   std::vector<char> solid_node_;         ///< per node: a node of a tetrahedron
   /// per node: [N] the force its hold took in the last step (> 0 pushing, < 0 pulling: let go for a step),
   /// 0 without a hold
   std::vector<double> hold_force_;
   std::vector<SolidContact> solid_contacts_;  ///< the solids' holds of the last Newton iteration
   const ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
+  std::optional<SurfaceContacts> surface_finder_;      ///< the solids' surfaces, made in analyze
+  const SurfaceContacts* surface_contacts_ = nullptr;  ///< surface_finder_ when it can find anything
+  std::vector<SurfaceTouch> touches_;                  ///< what it found at a step's first iteration
+  std::vector<SurfaceHold> surface_holds_;             ///< the holds of the last Newton iteration
+  /// per node: [N] the force its surface hold took in the last step (as hold_force_)
+  std::vector<double> surface_hold_force_;
+  NodeArray predicted_;  ///< x + h v where surface holds are found [m]
 };
 }  // namespace
 

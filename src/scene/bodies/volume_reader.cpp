@@ -39,7 +39,7 @@ void readPinnedNodesAndFaces(const Context& ctx, const Field& field, VolumeDef& 
 BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "shape", "size", "radius", "mesh", "resolution", "position",
-                                              "youngs_modulus", "poisson_ratio", "density", "pinned", "pressure" }));
+                                              "youngs_modulus", "poisson_ratio", "density", "pinned", "friction", "pressure" }));
   VolumeDef volume;
   volume.shape = readVolumeShape(ctx, requiredKey(ctx, field, "shape"));
   if (const std::optional<Field> value = optionalKey(field, "size"))
@@ -61,6 +61,8 @@ BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar&
   volume.density = readNumber(ctx, requiredKey(ctx, field, "density"));
   if (const std::optional<Field> value = optionalKey(field, "pinned"))
     readPinnedNodesAndFaces(ctx, *value, volume);
+  if (const std::optional<Field> value = optionalKey(field, "friction"))
+    volume.friction = readNumber(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "pressure"))
     volume.pressure = readNumber(ctx, *value);
   BodyDef body = buildBody(ctx, field, volume, buildVolume);

@@ -36,6 +36,9 @@ struct VolumeDef
   std::vector<std::string> pinned_faces;  ///< box only: every node on these faces is pinned: x_min,
                                           ///< x_max, y_min, y_max, z_min, z_max
   std::vector<int> pinned_nodes;   ///< node indices (negative from the end) pinned
+  /// Coulomb coefficient [-] >= 0 of its surface against other bodies' nodes (surface_contacts.h; two
+  /// volumes touching use the mean of theirs).
+  double friction = 0.0;
   /// [Pa] the rest pressure p0 of the gas each tetrahedron holds (tetrahedra.h), >= 0; 0: no gas.
   double pressure = 0.0;
 };
