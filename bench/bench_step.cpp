@@ -24,6 +24,9 @@
 // 100 kg/m^3) hanging from its top face, implicit_euler at 1/60 s, about 1,000 to 100,000 tetrahedra, its
 // linear solve made each way; items = tetrahedra, so the cost per tetrahedron per step and its growth. BM_TetKernel: the tetrahedron's force and
 // projected stiffness alone (tetForcesAndStiffness), per tetrahedron, on that box sagging.
+// BM_SoftStack/<touching|apart>: two 10 cm soft cubes (2.5 cm tetrahedra) on the floor at 1/60 s, one
+// resting on the other (its nodes held on the lower one's surface in the solve, about 100 holds) or beside
+// it: what the surface holds cost per step (World::step, settled for 2 s before timing).
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
 #include <cmath>
@@ -240,6 +243,35 @@ void BM_SoftBox(benchmark::State& bench, LinearSolve solve)
   bench.counters["tetrahedra"] = static_cast<double>(model.tetrahedra.size());
   bench.counters["nodes"] = model.nodeCount();
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.tetrahedra.size()));
+}
+
+void BM_SoftStack(benchmark::State& bench, bool touching)
+{
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 1, 1 };
+  scene.physics.gravity = Vec3(0.0, 0.0, -9.81);
+  scene.physics.drag = 5.0;
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  VolumeDef cube;
+  cube.size = Vec3(0.1, 0.1, 0.1);
+  cube.resolution = 0.025;
+  cube.youngs_modulus = 5.0e4;
+  cube.density = 100.0;
+  cube.friction = 0.5;
+  cube.position = Vec3(0.0, 0.0, 0.05);
+  scene.bodies.push_back(buildVolume("lower", cube));
+  cube.position = touching ? Vec3(0.0, 0.0, 0.151) : Vec3(0.3, 0.0, 0.05);
+  scene.bodies.push_back(buildVolume("upper", cube));
+  World world = buildWorld(scene);
+  for (int step = 0; step < 120; ++step)
+    world.step();
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations());
 }
 
 void BM_TetKernel(benchmark::State& bench)
@@ -541,6 +573,8 @@ BENCHMARK_CAPTURE(BM_SoftBox, cheaper, LinearSolve::Cheaper)->Arg(1700)->Arg(170
 BENCHMARK_CAPTURE(BM_SoftBox, direct, LinearSolve::Direct)->Arg(1700)->Arg(17000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SoftBox, iterative, LinearSolve::Iterative)->Arg(1700)->Arg(17000)->Arg(170000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_TetKernel);
+BENCHMARK_CAPTURE(BM_SoftStack, touching, true)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_SoftStack, apart, false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
 
