@@ -59,8 +59,8 @@ using Matrix3 = Eigen::Matrix3d;
 /// on the first step and after every model change, and each Newton iteration only writes its values and
 /// factorises. Every array is sized once: a step allocates nothing after the first.
 /// Other bodies' nodes touching a solid's surface are held on it in the same solve (addSurfaceHolds), their
-/// blocks coupling a node to a triangle's three: those lie outside the analysed pattern, so a step with any
-/// solves by conjugate gradients preconditioned by the factorisation without them (or block Jacobi).
+/// blocks coupling a node to a triangle's three: those node pairs join the analysed pattern when they
+/// first appear (placeHoldPairs).
 class ImplicitEuler final : public ForceBasedIntegrator
 {
 public:
@@ -266,8 +266,9 @@ private:
 
   /// The surface holds of a step: as a solid's node is held on a collider (addSolidContacts), a node p of
   /// another body (a rope's, a cloth's, another solid's) whose predicted position lies within its contact
-  /// radius of a solid's boundary triangle, or behind it (SurfaceContacts::find), or within |g| h^2 of
-  /// that unless its hold pulled in the last step, is held by a one-sided spring on the gap
+  /// radius of a solid's boundary triangle, or behind it (SurfaceContacts::find), or, if its hold pushed in
+  /// the last step, within max(|g| h^2, r_p / 2) of that (findSurfaceHolds), is held by a one-sided spring
+  /// on the gap
   /// g = n . (x_p - q) - r_p, q = sum_k w_k x_k the triangle's nearest point at weights w: the Jacobian of
   /// g is weights_l n^T on the four nodes, so the node and the triangle's nodes push each other apart with
   /// equal and opposite forces (momentum kept) and A gains h^2 k weights_l weights_m n n^T. k is
@@ -929,9 +930,6 @@ private:
       for (std::size_t p = 0; p < kTetPairs.size(); ++p)
         if (tet_slot_[6 * k + p] >= 0)
           solver.addOffDiagonal(static_cast<std::size_t>(tet_slot_[6 * k + p]), tet_blocks_[k].scaled.blocks[4 + p]);
-    // A is symmetric positive definite by construction (the transverse stiffness of compressed springs
-    // and the indefinite part of the gas's Hessian are dropped, see above), unless the state is not
-    // finite: then the step is not finite either, and the divergence guard (guard.h) takes it.
     // A surface hold's blocks weights_l weights_m B (only ever in the sparse pattern: a solid is no chain).
     for (std::size_t k = 0; k < surface_holds_.size(); ++k)
     {
@@ -944,6 +942,9 @@ private:
           solver.addOffDiagonal(static_cast<std::size_t>(hold_slots_[kFourNodePairs.size() * k + p]),
                                 (c.weights[kFourNodePairs[p].first] * c.weights[kFourNodePairs[p].second]) * c.block);
     }
+    // A is symmetric positive definite by construction (the transverse stiffness of compressed springs
+    // and the indefinite part of the gas's Hessian are dropped, see above), unless the state is not
+    // finite: then the step is not finite either, and the divergence guard (guard.h) takes it.
     if (solver.factorize())
       solver.solve(rhs_, delta_v_);
     else
