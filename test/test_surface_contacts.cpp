@@ -24,13 +24,7 @@ constexpr double kGravity = 9.81;
 BodyDef cube(const std::string& name, double size, const Vec3& centre, double youngs_modulus, double nu, double density,
              double friction, double resolution = 0.025)
 {
-  VolumeDef box;
-  box.size = Vec3::Constant(size);
-  box.resolution = resolution;
-  box.position = centre;
-  box.youngs_modulus = youngs_modulus;
-  box.poisson_ratio = nu;
-  box.density = density;
+  VolumeDef box = boxVolume(Vec3::Constant(size), resolution, centre, youngs_modulus, nu, density);
   box.friction = friction;
   return buildVolume(name, box);
 }

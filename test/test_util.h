@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "soft_body_sim/core/bodies/volume.h"
 #include "soft_body_sim/core/rods.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/core/stability.h"
@@ -18,6 +19,21 @@ namespace soft_body_sim::test
 /// Says that the running test is about the divergence guard, so its catches are expected; any other test
 /// that trips the guard fails (test_main.cpp).
 void expectGuardEvents();
+
+/// A box volume (buildVolume's VolumeDef) of full extents `size` [m] about `centre`, meshed at `resolution`
+/// [m], of Young's modulus E [Pa], Poisson's ratio nu and density rho [kg/m^3]; no friction, no gas.
+inline VolumeDef boxVolume(const Vec3& size, double resolution, const Vec3& centre, double youngs_modulus, double nu,
+                           double density)
+{
+  VolumeDef box;
+  box.size = size;
+  box.resolution = resolution;
+  box.position = centre;
+  box.youngs_modulus = youngs_modulus;
+  box.poisson_ratio = nu;
+  box.density = density;
+  return box;
+}
 
 /// Asserts |a - b|_inf <= tol and prints both sides on failure.
 template <typename A, typename B>

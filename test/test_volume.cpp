@@ -26,13 +26,7 @@ constexpr double kGravity = 9.81;
 BodyDef boxBody(const Vec3& size, double resolution, const Vec3& centre, double youngs_modulus, double nu, double density,
                 double pressure = 0.0)
 {
-  VolumeDef box;
-  box.size = size;
-  box.resolution = resolution;
-  box.position = centre;
-  box.youngs_modulus = youngs_modulus;
-  box.poisson_ratio = nu;
-  box.density = density;
+  VolumeDef box = boxVolume(size, resolution, centre, youngs_modulus, nu, density);
   box.pressure = pressure;
   return buildVolume("solid", box);
 }

@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include "soft_body_sim/core/bodies/rope.h"
-#include "soft_body_sim/core/bodies/volume.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test
@@ -153,12 +152,7 @@ TEST(BodyScaling, AVolumesModuliAndGasScaleOnlyInItsOwnBody)
 {
   // Two 2 cm cubes of E = 1e4 Pa, nu = 0.25 (mu = lambda = 4000 Pa), gas 1000 Pa; only b is scaled.
   SceneDef scene = oneBodyScene(IntegratorType::ImplicitEuler, 1e-3);
-  VolumeDef cube;
-  cube.size = Vec3(0.02, 0.02, 0.02);
-  cube.resolution = 0.02;
-  cube.youngs_modulus = 1.0e4;
-  cube.poisson_ratio = 0.25;
-  cube.density = 100.0;
+  VolumeDef cube = boxVolume(Vec3(0.02, 0.02, 0.02), 0.02, Vec3::Zero(), 1.0e4, 0.25, 100.0);
   cube.pressure = 1000.0;
   scene.bodies[0] = buildVolume("a", cube);
   cube.position = Vec3(0.1, 0.0, 0.0);
