@@ -44,6 +44,7 @@ TrianglePoint nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, con
 }
 
 SurfaceContacts::SurfaceContacts(const Model& model)
+  : widest_(model.contact_radius.size() > 0 ? model.contact_radius.maxCoeff() : 0.0)
 {
   if (model.bodies.size() < 2)
     return;
@@ -56,7 +57,6 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
                            std::vector<SurfaceTouch>& touches) const
 {
   touches.clear();
-  const double widest = model.contact_radius.size() > 0 ? model.contact_radius.maxCoeff() : 0.0;
   const auto inside = [](const Vec3& at, const Vec3& low, const Vec3& high) {
     return (at.array() >= low.array()).all() && (at.array() <= high.array()).all();
   };
@@ -73,8 +73,8 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
     }
     if (!low.allFinite() || !high.allFinite())
       continue;  // the divergence guard's case
-    low.array() -= widest + margin;
-    high.array() += widest + margin;
+    low.array() -= widest_ + margin;
+    high.array() += widest_ + margin;
     for (std::size_t other = 0; other < model.bodies.size(); ++other)
     {
       if (other == s)

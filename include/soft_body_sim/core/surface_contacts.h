@@ -44,6 +44,9 @@ public:
   /// True if no body can touch a solid's surface: find() finds nothing.
   bool empty() const { return solids_.empty(); }
 
+  /// The largest contact radius of any node [m] (radii are fixed when the world is built).
+  double widestRadius() const { return widest_; }
+
   /// Every node p of a body other than the solid's that is near or behind a solid's boundary triangle, into
   /// `touches` (cleared first). The triangle is the nearest to p at the positions x (the start of the step),
   /// and so are the weights and n: the triangle's outward normal where p is behind its plane, else the
@@ -62,6 +65,7 @@ public:
   static constexpr double kRounding = 0.1;
 
 private:
+  double widest_;                    ///< widestRadius()
   std::vector<std::size_t> solids_;  ///< bodies with a surface (Model::bodies), when another body exists
 };
 

@@ -304,10 +304,10 @@ private:
       c.block = c.scaled * (n * n.transpose());
       const double normal_force =
           std::max(block * c.depth / (h * h), surface_hold_force_[static_cast<std::size_t>(c.touch.node)]);
-      if (c.touch.friction > 0.0 && normal_force > 0.0)
+      Vec3 tangential;
+      const double damping = frictionDamping(c.touch.friction, normal_force, relative, n, tangential);
+      if (damping > 0.0)
       {
-        const Vec3 tangential = relative - relative.dot(n) * n;
-        const double damping = c.touch.friction * normal_force / std::max(tangential.norm(), kStickSpeed);
         push -= h * damping * tangential;
         c.block += h * damping * (Matrix3::Identity() - n * n.transpose());
       }
@@ -322,9 +322,8 @@ private:
   void findSurfaceHolds(const Model& model, const NodeArray& x, double h)
   {
     const double margin = model.gravity.norm() * h * h;
-    const double widest = model.contact_radius.size() > 0 ? model.contact_radius.maxCoeff() : 0.0;
     predicted_ = x + offset_;
-    surface_contacts_->find(model, x, predicted_, std::max(margin, 0.5 * widest), touches_);
+    surface_contacts_->find(model, x, predicted_, std::max(margin, 0.5 * surface_contacts_->widestRadius()), touches_);
     surface_holds_.clear();
     for (const SurfaceTouch& touch : touches_)
     {
@@ -414,11 +413,11 @@ private:
       d += c.scaled * (n * n.transpose());
       // A hold that pulled in the last step (< 0) adds nothing: only the approach's force presses then.
       const double normal_force = std::max(block * c.depth / (h * h), hold_force_[static_cast<std::size_t>(i)]);
-      if (!(c.contact.friction > 0.0 && normal_force > 0.0))
+      Vec3 tangential;
+      const double damping =
+          frictionDamping(c.contact.friction, normal_force, v.col(i) - c.contact.velocity, n, tangential);
+      if (!(damping > 0.0))
         continue;
-      const Vec3 relative = v.col(i) - c.contact.velocity;
-      const Vec3 tangential = relative - relative.dot(n) * n;
-      const double damping = c.contact.friction * normal_force / std::max(tangential.norm(), kStickSpeed);  // c [kg/s]
       rhs_.col(i) -= h * damping * tangential;
       d += h * damping * (Matrix3::Identity() - n * n.transpose());
     }
@@ -484,6 +483,19 @@ private:
       for (const SurfaceHold& c : surface_holds_)
         surface_hold_force_[static_cast<std::size_t>(c.touch.node)] = holdForce(c, h);
     }
+  }
+
+  /// Coulomb friction of a hold as a damping of its slip (addSolidContacts, addSurfaceHolds): the part v_t
+  /// of the `relative` velocity across n into `tangential`, and c = friction N / max(|v_t|, kStickSpeed)
+  /// [kg/s], 0 without friction or without a pressing force N. The hold's row gains -h c v_t, its block
+  /// h c (I - n n^T).
+  static double frictionDamping(double friction, double normal_force, const Vec3& relative, const Vec3& n,
+                                Vec3& tangential)
+  {
+    tangential = relative - relative.dot(n) * n;
+    if (!(friction > 0.0 && normal_force > 0.0))
+      return 0.0;
+    return friction * normal_force / std::max(tangential.norm(), kStickSpeed);
   }
 
   /// [m/s] below this tangential speed a solid's contact sticks (its friction's damping no longer grows).
