@@ -214,4 +214,68 @@ TEST(SurfaceContacts, ARopeDroppedAcrossACubeRestsOnItsTopAndNeverEntersIt)
   }
 }
 
+TEST(SurfaceContacts, ARopeRestsOnAPinnedBlockWhoseFreeNodesFormChains)
+{
+  // A solid with every node pinned is a fixed block, and a rope's free nodes form a chain: alone they
+  // would take the block-tridiagonal solve, which has no place for a hold's couplings to the block's
+  // triangles. The 40 cm rope of radius 5 mm dropped across the 10 cm block comes to rest on its top face
+  // at its radius and never enters it, at both steps. The same with two neighbouring nodes of the top face
+  // left free under the rope: their pair and the rope again form chains, and the block gives under it.
+  const double size = 0.1, radius = 0.005;
+  for (const bool two_free : { false, true })
+    for (const double dt : { 1.0 / 60.0, 1.0 / 240.0 })
+    {
+      SceneDef scene = floorScene(dt);
+      scene.physics.drag = 1.0;
+      RopeDef rope;
+      rope.nodes = 41;
+      rope.from = Vec3(-0.2, 0.0, size + 0.05);
+      rope.to = Vec3(0.2, 0.0, size + 0.05);
+      rope.mass = 0.02;
+      rope.stiffness = 200.0;
+      rope.damping = 0.05;
+      rope.radius = radius;
+      BodyDef block = cube("block", size, Vec3(0.0, 0.0, 0.5 * size), 5.0e4, 0.3, 100.0, 0.5);
+      for (NodeDef& node : block.nodes)
+        node.pinned = true;
+      if (two_free)
+      {
+        // The top node nearest the rope's middle, and its top neighbour nearest the rope's line.
+        const auto top = [&](std::size_t i) { return std::abs(block.nodes[i].position.z() - size) < 1e-9; };
+        const auto off_middle = [&](std::size_t i) { return block.nodes[i].position.head<2>().norm(); };
+        std::size_t middle = block.nodes.size();
+        for (std::size_t i = 0; i < block.nodes.size(); ++i)
+          if (top(i) && (middle == block.nodes.size() || off_middle(i) < off_middle(middle)))
+            middle = i;
+        std::size_t neighbour = middle;
+        for (const Tetrahedron& tet : block.tetrahedra)
+          for (const int a : tet.nodes)
+            for (const int b : tet.nodes)
+              if (static_cast<std::size_t>(a) == middle && b != a && top(static_cast<std::size_t>(b)) &&
+                  (neighbour == middle ||
+                   std::abs(block.nodes[static_cast<std::size_t>(b)].position.y()) < std::abs(block.nodes[neighbour].position.y())))
+                neighbour = static_cast<std::size_t>(b);
+        ASSERT_NE(neighbour, middle);
+        block.nodes[middle].pinned = block.nodes[neighbour].pinned = false;
+      }
+      scene.bodies = { block, buildRope("rope", rope) };
+      World world = buildWorld(scene);
+      const BodyRange& solid = world.model().bodies[0];
+      const BodyRange& line = world.model().bodies[1];
+      const std::string at = std::string(two_free ? "two free nodes" : "pinned") + ", dt " + std::to_string(dt);
+      const auto distance = [&](int i) { return signedDistance(solid, world.state().position, world.state().position.col(i)); };
+      double landing = INFINITY;
+      for (int step = 0; step < static_cast<int>(std::lround(5.0 / dt)); ++step)
+      {
+        world.step();
+        ASSERT_TRUE(allFinite(world.state())) << at;
+        for (int i = line.first; i < line.first + line.count; ++i)
+          landing = std::min(landing, distance(i));
+      }
+      EXPECT_GT(landing, 0.7 * radius) << at;
+      EXPECT_NEAR(distance(line.first + 20), radius, 0.02 * radius) << at;
+      EXPECT_LT(world.state().velocity.colwise().norm().maxCoeff(), 1e-3) << at;
+    }
+}
+
 }  // namespace soft_body_sim::test

@@ -832,7 +832,10 @@ private:
       }
     base_pairs_ = pairs.size();
     hold_slot_.clear();
-    chains_ = linear_solve_ != LinearSolve::Iterative && chain_solver_.analyze(model.nodeCount(), pairs);
+    // A surface hold couples a node to a triangle of another body, which a chain's pattern has no place
+    // for: where holds can arise, the sparse solver (or CG) solves.
+    chains_ = surface_contacts_ == nullptr && linear_solve_ != LinearSolve::Iterative &&
+              chain_solver_.analyze(model.nodeCount(), pairs);
     factorable_ = chains_ || (linear_solve_ != LinearSolve::Iterative &&
                               solver_.analyze(model.nodeCount(), pairs,
                                               linear_solve_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork));
@@ -942,7 +945,7 @@ private:
       for (std::size_t p = 0; p < kTetPairs.size(); ++p)
         if (tet_slot_[6 * k + p] >= 0)
           solver.addOffDiagonal(static_cast<std::size_t>(tet_slot_[6 * k + p]), tet_blocks_[k].scaled.blocks[4 + p]);
-    // A surface hold's blocks weights_l weights_m B (only ever in the sparse pattern: a solid is no chain).
+    // A surface hold's blocks weights_l weights_m B (only ever in the sparse pattern: see analyze's chains_).
     for (std::size_t k = 0; k < surface_holds_.size(); ++k)
     {
       const SurfaceHold& c = surface_holds_[k];
