@@ -116,7 +116,7 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
                                    on.weight[1] * predicted.col(t[1]) - on.weight[2] * predicted.col(t[2]);
         const double depth = model.contact_radius[p] - normal.dot(predicted_gap);
         if (depth > -margin)
-          touches.push_back({ p, t, on.weight, normal, depth, friction });
+          touches.push_back({ p, t, on.weight, normal, predicted_gap, depth, friction });
       }
     }
   }

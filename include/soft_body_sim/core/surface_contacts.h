@@ -32,6 +32,7 @@ struct SurfaceTouch
   std::array<int, 3> triangle;
   Vec3 weight;
   Vec3 normal;
+  Vec3 gap;  ///< x_p - q [m] at the predicted positions
   double depth;
   double friction;  ///< Coulomb coefficient: the solid's `friction`, the mean of two solids'
 };

@@ -248,7 +248,7 @@ private:
       addTetrahedra(model, x, h);
     if (contacts_ != nullptr)
       addSolidContacts(model, x, v, h, first_iteration);
-    if (surface_contacts_ != nullptr)
+    if (surface_contacts_.has_value())
       addSurfaceHolds(model, x, v, h, first_iteration);
   }
 
@@ -258,7 +258,6 @@ private:
     SurfaceTouch touch;  ///< as found at the step's first Newton iteration (node p, triangle, weights, n)
     int nodes[4];        ///< p, then the triangle's three nodes, each -1 where pinned
     double weights[4];   ///< 1, -w_0, -w_1, -w_2: the gap x_p - q = sum_l weights_l x_l
-    Vec3 found_gap;      ///< [m] the gap at the predicted positions where it was found
     double depth;        ///< d [m] at this iteration's predicted positions
     double scaled;       ///< h^2 k [kg] in this iteration
     Matrix3 block;       ///< B = h^2 k n n^T + h c (I - n n^T); A gains weights_l weights_m B on (l, m)
@@ -293,7 +292,7 @@ private:
         if (c.nodes[l] >= 0)
           inverse_block += c.weights[l] * c.weights[l] / (diagonal_[static_cast<std::size_t>(c.nodes[l])].trace() / 3.0);
       }
-      c.depth = c.touch.depth - n.dot(gap - c.found_gap);
+      c.depth = c.touch.depth - n.dot(gap - c.touch.gap);
       c.scaled = 0.0;
       c.block.setZero();
       if (!(inverse_block > 0.0))
@@ -336,20 +335,11 @@ private:
       SurfaceHold c;
       c.touch = touch;
       const int all[4] = { touch.node, touch.triangle[0], touch.triangle[1], touch.triangle[2] };
-      c.weights[0] = 1.0;
-      c.found_gap = predicted_.col(touch.node);
       for (int l = 0; l < 4; ++l)
       {
-        if (l > 0)
-        {
-          c.weights[l] = -touch.weight[l - 1];
-          c.found_gap += c.weights[l] * predicted_.col(all[l]);
-        }
+        c.weights[l] = l == 0 ? 1.0 : -touch.weight[l - 1];
         c.nodes[l] = model.isFree(all[l]) ? all[l] : -1;
       }
-      c.depth = touch.depth;
-      c.scaled = 0.0;
-      c.block.setZero();
       surface_holds_.push_back(c);
     }
   }
@@ -458,7 +448,7 @@ private:
       solid_contacts_.erase(std::remove_if(solid_contacts_.begin(), solid_contacts_.end(),
                                            [&](const SolidContact& c) { return holdForce(c, h) < 0.0; }),
                             solid_contacts_.end());
-    if (surface_contacts_ != nullptr)
+    if (surface_contacts_.has_value())
       surface_holds_.erase(std::remove_if(surface_holds_.begin(), surface_holds_.end(),
                                           [&](const SurfaceHold& c) { return holdForce(c, h) < 0.0; }),
                            surface_holds_.end());
@@ -477,7 +467,7 @@ private:
       for (const SolidContact& c : solid_contacts_)
         hold_force_[static_cast<std::size_t>(c.node)] = holdForce(c, h);
     }
-    if (surface_contacts_ != nullptr)
+    if (surface_contacts_.has_value())
     {
       std::fill(surface_hold_force_.begin(), surface_hold_force_.end(), 0.0);
       for (const SurfaceHold& c : surface_holds_)
@@ -808,11 +798,12 @@ private:
     for (const Tetrahedron& tet : model.tetrahedra)
       for (const int node : tet.nodes)
         solid_node_[static_cast<std::size_t>(node)] = 1;
-    surface_finder_.emplace(model);
-    surface_contacts_ = model.tetrahedra.empty() || surface_finder_->empty() ? nullptr : &*surface_finder_;
+    surface_contacts_.emplace(model);
+    if (model.tetrahedra.empty() || surface_contacts_->empty())
+      surface_contacts_.reset();
     surface_hold_force_.assign(static_cast<std::size_t>(model.nodeCount()), 0.0);
     surface_holds_.clear();
-    if (surface_contacts_ != nullptr)
+    if (surface_contacts_.has_value())
     {
       // A node touches at most one triangle of each solid.
       const std::size_t most = static_cast<std::size_t>(model.nodeCount()) * model.bodies.size();
@@ -834,7 +825,7 @@ private:
     hold_slot_.clear();
     // A surface hold couples a node to a triangle of another body, which a chain's pattern has no place
     // for: where holds can arise, the sparse solver (or CG) solves.
-    chains_ = surface_contacts_ == nullptr && linear_solve_ != LinearSolve::Iterative &&
+    chains_ = !surface_contacts_.has_value() && linear_solve_ != LinearSolve::Iterative &&
               chain_solver_.analyze(model.nodeCount(), pairs);
     factorable_ = chains_ || (linear_solve_ != LinearSolve::Iterative &&
                               solver_.analyze(model.nodeCount(), pairs,
@@ -1028,8 +1019,7 @@ private:
   std::vector<double> hold_force_;
   std::vector<SolidContact> solid_contacts_;  ///< the solids' holds of the last Newton iteration
   const ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
-  std::optional<SurfaceContacts> surface_finder_;      ///< the solids' surfaces, made in analyze
-  const SurfaceContacts* surface_contacts_ = nullptr;  ///< surface_finder_ when it can find anything
+  std::optional<SurfaceContacts> surface_contacts_;  ///< the solids' surfaces, made in analyze if it can find anything
   std::vector<SurfaceTouch> touches_;                  ///< what it found at a step's first iteration
   std::vector<SurfaceHold> surface_holds_;             ///< the holds of the last Newton iteration
   /// per node: [N] the force its surface hold took in the last step (as hold_force_)
