@@ -1609,6 +1609,17 @@ TEST(SceneLoader, AMeshVolumeFillsItsSurfaceFile)
   EXPECT_EQ(buildWorld(scene).model().tetrahedra.size(), body.tetrahedra.size());
 }
 
+TEST(SceneLoader, AVolumeFinerThanTheCallersLimitIsRefusedAtItsResolution)
+{
+  // A 4 cm cube at 1 cm: kTetsPerMaxVolume V / v_max = 3.5 x 6.4e-5 m^3 / (1e-6 m^3 / (2 sqrt 2)) = 634
+  // tetrahedra estimated. Under a limit of 500 it is refused before meshing; under 1000 it meshes.
+  const std::string yaml = "bodies:\n  - {name: s, type: volume, resolution: 0.01, position: [0, 0, 1], "
+                           "youngs_modulus: 5e4, density: 100, shape: box, size: [0.04, 0.04, 0.04]}\n";
+  expectSceneError([&] { parseScene(yaml, "bad.yaml", SceneLimits{ 500.0 }); }, yaml,
+                   "bad.yaml:2: bodies[0].resolution", { "about 634 tetrahedra, over the limit of 500" });
+  EXPECT_FALSE(parseScene(yaml, "good.yaml", SceneLimits{ 1000.0 }).bodies[0].tetrahedra.empty());
+}
+
 TEST(SceneLoader, AVolumesMistakesAreNamedAtTheirKeys)
 {
   const std::string box = "{name: s, type: volume, resolution: 0.02, position: [0, 0, 1], youngs_modulus: 5e4, "

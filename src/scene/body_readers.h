@@ -38,7 +38,8 @@ inline int readNodeIndex(const Context& ctx, const Field& field, int node_count)
 struct SceneSoFar
 {
   const PhysicsDef& physics;
-  long long nodes = 0;  ///< nodes of the bodies before this one
+  double max_tetrahedra;  ///< the most tetrahedra a volume's mesh may be asked for (SceneLimits)
+  long long nodes = 0;    ///< nodes of the bodies before this one
 
   /// Fails at `field` if a body of `body_nodes` nodes would take the scene over kMaxSceneNodes. Each reader
   /// calls it before building its body, so that a scene over the limit fails without first taking the

@@ -295,7 +295,7 @@ BodyDef readBody(const Context& ctx, const Field& field, const SceneSoFar& scene
   ctx.fail(type, "unknown body type " + quoted(name) + "; valid types: " + join(names));
 }
 
-SceneDef readScene(const Context& ctx, const Field& root)
+SceneDef readScene(const Context& ctx, const Field& root, const SceneLimits& limits)
 {
   if (!root.node.IsMap())
     ctx.fail(root, "a scene must be a YAML mapping with the keys " + join(kSceneKeys) + "; got " +
@@ -330,7 +330,7 @@ SceneDef readScene(const Context& ctx, const Field& root)
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error
-  SceneSoFar so_far{ scene.physics };
+  SceneSoFar so_far{ scene.physics, limits.tetrahedra };
   for (const Field& item : requireList(ctx, bodies))
   {
     scene.bodies.push_back(readBody(ctx, item, so_far));
@@ -406,11 +406,11 @@ SceneDef loadSceneFile(const std::string& path)
   return parseScene(text, path);
 }
 
-SceneDef parseScene(const std::string& yaml_text, const std::string& source)
+SceneDef parseScene(const std::string& yaml_text, const std::string& source, const SceneLimits& limits)
 {
   const Context ctx(source);
   const YAML::Node root = loadSingleDocument(ctx, yaml_text);
-  return readScene(ctx, Field{ root, "", root.Mark() });
+  return readScene(ctx, Field{ root, "", root.Mark() }, limits);
 }
 
 }  // namespace soft_body_sim

@@ -61,11 +61,11 @@ TetMesh meshShape(const VolumeDef& volume, const std::string& what)
     switch (volume.shape)
     {
       case VolumeShape::Box:
-        return meshBox(*volume.size, volume.resolution);
+        return meshBox(*volume.size, volume.resolution, volume.max_tetrahedra);
       case VolumeShape::Sphere:
-        return meshSphere(*volume.radius, volume.resolution);
+        return meshSphere(*volume.radius, volume.resolution, volume.max_tetrahedra);
       case VolumeShape::Mesh:
-        return meshSurface(volume.surface, volume.resolution);
+        return meshSurface(volume.surface, volume.resolution, volume.max_tetrahedra);
     }
   }
   catch (const DefinitionError& e)

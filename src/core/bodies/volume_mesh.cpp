@@ -48,16 +48,16 @@ std::string str(const Eigen::Vector3d& point)
 /// tetrahedron gave 0.56 to 0.70).
 double maxTetVolume(double resolution) { return resolution * resolution * resolution / (2.0 * std::sqrt(2.0)); }
 
-/// Throws unless `resolution` [m] is > 0 and meshes `volume` [m^3] in at most kMaxTetrahedra.
-void requireResolution(double resolution, double volume, const std::string& what)
+/// Throws unless `resolution` [m] is > 0 and meshes `volume` [m^3] in at most `most` tetrahedra.
+void requireResolution(double resolution, double volume, double most, const std::string& what)
 {
   requireDefinition(resolution > 0.0 && std::isfinite(resolution), what, { "resolution" },
                     "resolution must be > 0 (the target edge length [m]), not " + str(resolution));
   const double estimate = kTetsPerMaxVolume * volume / maxTetVolume(resolution);
-  requireDefinition(estimate <= kMaxTetrahedra, what, { "resolution" },
+  requireDefinition(estimate <= most, what, { "resolution" },
                     "resolution " + str(resolution) + " m is too fine: it would make about " +
                         std::to_string(std::llround(estimate)) + " tetrahedra, over the limit of " +
-                        std::to_string(std::llround(kMaxTetrahedra)) + "; choose a coarser one");
+                        std::to_string(std::llround(most)) + "; choose a coarser one");
 }
 
 /// The faces of the tetrahedra (a, b, c, d) that belong to one only, each turned out of its tetrahedron.
@@ -296,12 +296,12 @@ double enclosedVolume(const TriangleMesh& surface)
   return volume;
 }
 
-TetMesh meshBox(const Eigen::Vector3d& size, double resolution)
+TetMesh meshBox(const Eigen::Vector3d& size, double resolution, double max_tetrahedra)
 {
   const std::string what = "volume box";
   requireDefinition((size.array() > 0.0).all() && size.allFinite(), what, { "size" },
                     "size must be > 0 in x, y and z (full extents [m]), not " + str(size));
-  requireResolution(resolution, size.prod(), what);
+  requireResolution(resolution, size.prod(), max_tetrahedra, what);
   Plc box;
   for (int corner = 0; corner < 8; ++corner)  // bit 0: +x, bit 1: +y, bit 2: +z
   {
@@ -312,22 +312,22 @@ TetMesh meshBox(const Eigen::Vector3d& size, double resolution)
   return meshPlc(box, resolution);
 }
 
-TetMesh meshSphere(double radius, double resolution)
+TetMesh meshSphere(double radius, double resolution, double max_tetrahedra)
 {
   const std::string what = "volume sphere";
   requireDefinition(radius > 0.0 && std::isfinite(radius), what, { "radius" },
                     "radius must be > 0 [m], not " + str(radius));
-  requireResolution(resolution, 4.0 / 3.0 * M_PI * radius * radius * radius, what);
+  requireResolution(resolution, 4.0 / 3.0 * M_PI * radius * radius * radius, max_tetrahedra, what);
   // The icosahedron inscribed in the unit sphere has edges 1 / sin(2 pi / 5) = 1.0515 long.
   const int n = static_cast<int>(std::ceil(radius / (std::sin(0.4 * M_PI) * resolution)));
   return meshPlc(geodesicSphere(radius, n), resolution);
 }
 
-TetMesh meshSurface(const TriangleMesh& surface, double resolution)
+TetMesh meshSurface(const TriangleMesh& surface, double resolution, double max_tetrahedra)
 {
   const std::string what = "volume mesh surface";
   requireMeshableSurface(surface, what);
-  requireResolution(resolution, std::abs(enclosedVolume(surface)), what);
+  requireResolution(resolution, std::abs(enclosedVolume(surface)), max_tetrahedra, what);
   const Plc plc = surfacePlc(surface);
   const std::vector<int> crossing = intersectingFacets(plc);
   if (!crossing.empty())

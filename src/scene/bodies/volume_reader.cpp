@@ -65,6 +65,7 @@ BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar&
     volume.friction = readNumber(ctx, *value);
   if (const std::optional<Field> value = optionalKey(field, "pressure"))
     volume.pressure = readNumber(ctx, *value);
+  volume.max_tetrahedra = scene.max_tetrahedra;
   BodyDef body = buildBody(ctx, field, volume, buildVolume);
   // The node count is known only after meshing; the mesher's own limit (kMaxTetrahedra) bounds the memory
   // that takes, so the scene's limit is checked here, at the key that sets the count.

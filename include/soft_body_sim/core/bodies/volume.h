@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "soft_body_sim/core/bodies/volume_mesh.h"
 #include "soft_body_sim/core/mesh_field.h"
 #include "soft_body_sim/core/scene_def.h"
 
@@ -41,6 +42,8 @@ struct VolumeDef
   double friction = 0.0;
   /// [Pa] the rest pressure p0 of the gas each tetrahedron holds (tetrahedra.h), >= 0; 0: no gas.
   double pressure = 0.0;
+  /// The most tetrahedra its mesh may be asked for (volume_mesh.h): a finer resolution is refused.
+  double max_tetrahedra = kMaxTetrahedra;
 };
 
 /// The volume as nodes (mesh node + position) and tetrahedra of its material (lameParameters(E, nu)),

@@ -37,9 +37,10 @@ double meshVolume(const TetMesh& mesh);
 /// oriented surface encloses by the divergence theorem, > 0 when its triangles face outward.
 double enclosedVolume(const TriangleMesh& surface);
 
-/// The most tetrahedra a mesh may be asked for: kTetsPerMaxVolume V / v_max, estimated before meshing
-/// from the shape's volume V [m^3] and the volume bound v_max = resolution^3 / (2 sqrt 2) [m^3] that the
-/// mesh is made with, may not exceed it; a finer resolution is refused.
+/// The most tetrahedra a mesh may be asked for (the default of each mesher's max_tetrahedra):
+/// kTetsPerMaxVolume V / v_max, estimated before meshing from the shape's volume V [m^3] and the volume
+/// bound v_max = resolution^3 / (2 sqrt 2) [m^3] that the mesh is made with, may not exceed it; a finer
+/// resolution is refused.
 constexpr double kMaxTetrahedra = 2.0e6;
 /// Tetrahedra per v_max of volume in TetGen's quality meshes: measured 2.0 to 3.5 on boxes, spheres and
 /// config/meshes/part.stl at 10 to 40 tetrahedra across, the regime of any mesh near the limit, so the
@@ -61,8 +62,8 @@ constexpr double kTetsPerMaxVolume = 3.5;
 
 /// The box of full extents `size` [m] (x, y, z) about the origin. Its six faces are flat, so the
 /// tetrahedra fill it exactly. Throws DefinitionError (keys "size", "resolution") when a component of
-/// `size` or `resolution` is not > 0, or the mesh would exceed kMaxTetrahedra.
-TetMesh meshBox(const Eigen::Vector3d& size, double resolution);
+/// `size` or `resolution` is not > 0, or the mesh would exceed max_tetrahedra.
+TetMesh meshBox(const Eigen::Vector3d& size, double resolution, double max_tetrahedra = kMaxTetrahedra);
 
 /// The ball of `radius` r [m] about the origin, meshed inside a geodesic polyhedron inscribed in its
 /// sphere: an icosahedron (edge a = r / sin(2 pi / 5) = 1.0515 r) whose edges are split into
@@ -72,8 +73,8 @@ TetMesh meshBox(const Eigen::Vector3d& size, double resolution);
 /// at most 0.51 (resolution / r)^2 for every n (0.357 at n = 1, 0.458 at 2, 0.497 at 6, 0.502 at 20 and
 /// 40, computed for the resolution a / n; a coarser resolution with the same n has the same deficit).
 /// Throws DefinitionError (keys "radius", "resolution") when either is not > 0 or the mesh would exceed
-/// kMaxTetrahedra.
-TetMesh meshSphere(double radius, double resolution);
+/// max_tetrahedra.
+TetMesh meshSphere(double radius, double resolution, double max_tetrahedra = kMaxTetrahedra);
 
 /// The solid that the closed triangle `surface` [m] bounds, in the surface's frame. The surface's own
 /// vertices stay nodes of the mesh; TetGen may add nodes on its triangles. Its triangles may face all
@@ -82,7 +83,7 @@ TetMesh meshSphere(double radius, double resolution);
 /// inconsistently oriented (two triangles run a shared edge the same way), intersects itself (TetGen -d),
 /// has a shell inside another (a cavity: TetGen would fill it) or shells facing different ways (then
 /// the tetrahedra's volume differs from the surface's enclosedVolume by over 1e-9 of it), or the mesh
-/// would exceed kMaxTetrahedra; the message names the edge or triangle at fault.
-TetMesh meshSurface(const TriangleMesh& surface, double resolution);
+/// would exceed max_tetrahedra; the message names the edge or triangle at fault.
+TetMesh meshSurface(const TriangleMesh& surface, double resolution, double max_tetrahedra = kMaxTetrahedra);
 
 }  // namespace soft_body_sim
