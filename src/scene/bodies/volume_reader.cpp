@@ -67,7 +67,7 @@ BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar&
     volume.pressure = readNumber(ctx, *value);
   volume.max_tetrahedra = scene.max_tetrahedra;
   BodyDef body = buildBody(ctx, field, volume, buildVolume);
-  // The node count is known only after meshing; the mesher's own limit (kMaxTetrahedra) bounds the memory
+  // The node count is known only after meshing; the mesher's own limit (max_tetrahedra) bounds the memory
   // that takes, so the scene's limit is checked here, at the key that sets the count.
   scene.requireNodes(ctx, resolution, static_cast<long long>(body.nodes.size()));
   return body;
