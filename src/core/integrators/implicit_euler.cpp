@@ -824,12 +824,12 @@ private:
     base_pairs_ = pairs.size();
     hold_slot_.clear();
     // A surface hold couples a node to a triangle of another body, which a chain's pattern has no place
-    // for: where holds can arise, the sparse solver (or CG) solves.
-    chains_ = !surface_contacts_.has_value() && linear_solve_ != LinearSolve::Iterative &&
-              chain_solver_.analyze(model.nodeCount(), pairs);
-    factorable_ = chains_ || (linear_solve_ != LinearSolve::Iterative &&
-                              solver_.analyze(model.nodeCount(), pairs,
-                                              linear_solve_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork));
+    // for: where holds can arise, the sparse pattern is prepared too, for the steps that have any.
+    chains_ = linear_solve_ != LinearSolve::Iterative && chain_solver_.analyze(model.nodeCount(), pairs);
+    factorable_ = (chains_ && !surface_contacts_.has_value()) ||
+                  (linear_solve_ != LinearSolve::Iterative &&
+                   solver_.analyze(model.nodeCount(), pairs,
+                                   linear_solve_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork));
     analyzed_ = true;
   }
 
@@ -872,14 +872,15 @@ private:
   }
 
   /// delta_v_ = A^-1 rhs_: directly, A written from the blocks of assemble into the analysed pattern (block
-  /// tridiagonal where the free nodes form chains, else sparse), or by conjugate gradients where they cost
+  /// tridiagonal where the free nodes form chains and no surface hold joins them to a solid in this step,
+  /// else sparse), or by conjugate gradients where they cost
   /// less (see kDirectWorkPerRootCondition). A chain's factorisation costs about as much as one CG sweep, so
   /// a chain always takes the direct path.
   void solve(const Model& model)
   {
     if (!analyzed_)
       analyze(model);
-    if (chains_)
+    if (chains_ && surface_holds_.empty())
     {
       solveDirectly(model, chain_solver_);
       return;
@@ -998,7 +999,7 @@ private:
   SparseBlockSolver solver_;
   BlockTridiagonalSolver chain_solver_;
   bool analyzed_ = false;          ///< the solvers hold the pattern of the current model
-  bool chains_ = false;            ///< the free nodes form chains: chain_solver_ solves
+  bool chains_ = false;            ///< the free nodes form chains: chain_solver_ solves (steps without surface holds)
   bool factorable_ = true;         ///< the pattern is prepared for the direct solve (see kMaxFactorWork)
   double condition_ = 1.0;         ///< estimate of block-Jacobi preconditioned A's condition number
   std::vector<int> spring_slot_;   ///< per spring: its slot in solver_, or -1 (not coupled)
