@@ -29,6 +29,21 @@ BodyDef cube(const std::string& name, double size, const Vec3& centre, double yo
   return buildVolume(name, box);
 }
 
+/// A 40 cm rope of radius `radius` [m] (41 nodes, 20 g) along x, 5 cm above a cube of edge `size` [m] whose
+/// bottom is at z = 0.
+BodyDef ropeAcross(double size, double radius)
+{
+  RopeDef rope;
+  rope.nodes = 41;
+  rope.from = Vec3(-0.2, 0.0, size + 0.05);
+  rope.to = Vec3(0.2, 0.0, size + 0.05);
+  rope.mass = 0.02;
+  rope.stiffness = 200.0;
+  rope.damping = 0.05;
+  rope.radius = radius;
+  return buildRope("rope", rope);
+}
+
 SceneDef floorScene(double dt)
 {
   SceneDef scene;
@@ -177,15 +192,7 @@ TEST(SurfaceContacts, ARopeDroppedAcrossACubeRestsOnItsTopAndNeverEntersIt)
   {
     SceneDef scene = floorScene(dt);
     scene.physics.drag = 1.0;
-    RopeDef rope;
-    rope.nodes = 41;
-    rope.from = Vec3(-0.2, 0.0, size + 0.05);
-    rope.to = Vec3(0.2, 0.0, size + 0.05);
-    rope.mass = 0.02;
-    rope.stiffness = 200.0;
-    rope.damping = 0.05;
-    rope.radius = radius;
-    scene.bodies = { cube("cube", size, Vec3(0.0, 0.0, 0.5 * size), 5.0e4, 0.3, 100.0, 0.5), buildRope("rope", rope) };
+    scene.bodies = { cube("cube", size, Vec3(0.0, 0.0, 0.5 * size), 5.0e4, 0.3, 100.0, 0.5), ropeAcross(size, radius) };
     World world = buildWorld(scene);
     const BodyRange& solid = world.model().bodies[0];
     const BodyRange& line = world.model().bodies[1];
@@ -227,14 +234,6 @@ TEST(SurfaceContacts, ARopeRestsOnAPinnedBlockWhoseFreeNodesFormChains)
     {
       SceneDef scene = floorScene(dt);
       scene.physics.drag = 1.0;
-      RopeDef rope;
-      rope.nodes = 41;
-      rope.from = Vec3(-0.2, 0.0, size + 0.05);
-      rope.to = Vec3(0.2, 0.0, size + 0.05);
-      rope.mass = 0.02;
-      rope.stiffness = 200.0;
-      rope.damping = 0.05;
-      rope.radius = radius;
       BodyDef block = cube("block", size, Vec3(0.0, 0.0, 0.5 * size), 5.0e4, 0.3, 100.0, 0.5);
       for (NodeDef& node : block.nodes)
         node.pinned = true;
@@ -258,7 +257,7 @@ TEST(SurfaceContacts, ARopeRestsOnAPinnedBlockWhoseFreeNodesFormChains)
         ASSERT_NE(neighbour, middle);
         block.nodes[middle].pinned = block.nodes[neighbour].pinned = false;
       }
-      scene.bodies = { block, buildRope("rope", rope) };
+      scene.bodies = { block, ropeAcross(size, radius) };
       World world = buildWorld(scene);
       const BodyRange& solid = world.model().bodies[0];
       const BodyRange& line = world.model().bodies[1];
