@@ -144,11 +144,11 @@ World offRest(const SceneDef& scene)
   return world;
 }
 
-/// The force [N] the integrator of `scene` applies to each node off rest (offRest): a step of h = 1e-9 s
-/// takes v = h f / m (implicit Euler's h^2 K / m and the constraints' h^2 / (alpha m) are 1e-18 of it or less).
-NodeArray appliedForces(SceneDef scene)
+/// The force [N] the integrator of `scene` applies to each node off rest (offRest): a step of h takes
+/// v = h f / m up to h^2 K / m (implicit Euler) or h^2 w / alpha (XPBD's compliance), far below 1e-6 at the
+/// steps below. XPBD moves positions, so its h must keep h^2 f / m well above the positions' round-off.
+NodeArray appliedForces(SceneDef scene, double h)
 {
-  const double h = 1e-9;
   scene.physics.step.dt = h;
   World world = offRest(scene);
   world.step();
@@ -185,7 +185,7 @@ NodeArray energyGradientForces(const SceneDef& scene, double delta)
 TEST(Energy, TheForceOfEveryElementKindIsMinusTheGradientOfTheEnergyTheWorldReports)
 {
   const SceneDef scene = sceneOf(everyKind(), IntegratorType::ImplicitEuler, 0.01);
-  const NodeArray applied = appliedForces(scene);
+  const NodeArray applied = appliedForces(scene, 1e-9);
   // Central differences err by delta^2 / 6 times the third derivative: at 1e-6 m, far below 1e-6 of the forces.
   const NodeArray gradient = energyGradientForces(scene, 1e-6);
   const double scale = applied.cwiseAbs().maxCoeff();
@@ -212,7 +212,7 @@ TEST(Energy, ACompliantDistanceConstraintStoresHalfItsViolationSquaredOverItsCom
     expected += violation * violation / (2.0 * alpha);
   }
   EXPECT_NEAR(world.energy(), expected, 1e-12 * expected);
-  const NodeArray applied = appliedForces(scene);
+  const NodeArray applied = appliedForces(scene, 1e-6);
   EXPECT_TRUE(test::expectNear(energyGradientForces(scene, 1e-7), applied, 1e-5 * applied.cwiseAbs().maxCoeff()));
 }
 
