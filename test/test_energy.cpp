@@ -106,9 +106,9 @@ TEST(Energy, ABarHangingFromItsTopStoresItsClosedFormElasticEnergy)
   EXPECT_NEAR(elastic, expected, 0.02 * expected);
 }
 
-/// Every element kind in one scene, each off its rest shape: a rope of springs, a jelly (springs and gas
-/// cells), a rod (springs, bending, twisting), a soft block (tetrahedra with gas); no damping, no gravity.
-std::vector<BodyDef> everyKindOffRest()
+/// Every element kind in one scene: a rope of springs, a jelly (springs and gas cells), a rod (springs,
+/// bending, twisting), a soft block (tetrahedra with gas); no damping, no gravity.
+std::vector<BodyDef> everyKind()
 {
   RopeDef rope;
   rope.nodes = 6;
@@ -127,25 +127,30 @@ std::vector<BodyDef> everyKindOffRest()
   rod.youngs_modulus = 1.0e7;
   VolumeDef block = boxVolume(Vec3(0.1, 0.1, 0.1), 0.05, Vec3(0, 3, 0), 5.0e4, 0.3, 100.0);
   block.pressure = 1.0e4;
-  std::vector<BodyDef> bodies{ buildRope("rope", rope), buildJelly("jelly", jelly), buildRod("rod", rod),
-                               buildVolume("block", block) };
-  // Each node displaced by a smooth, deterministic field of a few per cent of the bodies' sizes.
-  for (BodyDef& body : bodies)
-    for (std::size_t k = 0; k < body.nodes.size(); ++k)
-    {
-      const double s = static_cast<double>(k);
-      body.nodes[k].position += 0.01 * Vec3(std::sin(1.3 * s), std::cos(0.7 * s), std::sin(0.4 * s + 1.0));
-    }
-  return bodies;
+  return { buildRope("rope", rope), buildJelly("jelly", jelly), buildRod("rod", rod), buildVolume("block", block) };
 }
 
-/// The force [N] the integrator of `scene` applies to each node from rest: a step of h = 1e-9 s takes
-/// v = h f / m (implicit Euler's h^2 K / m and the constraints' h^2 / (alpha m) are 1e-18 of it or less).
-NodeArray appliedForces(SceneDef scene)
+/// The world of `scene` with every node moved off its rest shape, at rest, by a smooth, deterministic field
+/// of a few per cent of the bodies' sizes.
+World offRest(const SceneDef& scene)
 {
-  const double h = 1e-9;
-  scene.physics.step.dt = h;
   World world = buildWorld(scene);
+  for (int i = 0; i < world.model().nodeCount(); ++i)
+  {
+    const double s = static_cast<double>(i);
+    world.setNode(i, world.state().position.col(i) + 0.01 * Vec3(std::sin(1.3 * s), std::cos(0.7 * s), std::sin(0.4 * s + 1.0)),
+                  Vec3::Zero());
+  }
+  return world;
+}
+
+/// The force [N] the integrator of `scene` applies to each node off rest (offRest): a step of h takes
+/// v = h f / m up to h^2 K / m (implicit Euler) or h^2 w / alpha (XPBD's compliance), far below 1e-6 at the
+/// steps below. XPBD moves positions, so its h must keep h^2 f / m well above the positions' round-off.
+NodeArray appliedForces(SceneDef scene, double h)
+{
+  scene.physics.step.dt = h;
+  World world = offRest(scene);
   world.step();
   NodeArray force = world.state().velocity / h;
   for (int i = 0; i < world.model().nodeCount(); ++i)
@@ -153,10 +158,10 @@ NodeArray appliedForces(SceneDef scene)
   return force;
 }
 
-/// -dE/dx of the world's reported energy, by central differences of step delta [m].
+/// -dE/dx of the world's reported energy off rest (offRest), by central differences of step delta [m].
 NodeArray energyGradientForces(const SceneDef& scene, double delta)
 {
-  World world = buildWorld(scene);
+  World world = offRest(scene);
   NodeArray force(3, world.model().nodeCount());
   for (int i = 0; i < world.model().nodeCount(); ++i)
   {
@@ -179,8 +184,8 @@ NodeArray energyGradientForces(const SceneDef& scene, double delta)
 
 TEST(Energy, TheForceOfEveryElementKindIsMinusTheGradientOfTheEnergyTheWorldReports)
 {
-  const SceneDef scene = sceneOf(everyKindOffRest(), IntegratorType::ImplicitEuler, 0.01);
-  const NodeArray applied = appliedForces(scene);
+  const SceneDef scene = sceneOf(everyKind(), IntegratorType::ImplicitEuler, 0.01);
+  const NodeArray applied = appliedForces(scene, 1e-9);
   // Central differences err by delta^2 / 6 times the third derivative: at 1e-6 m, far below 1e-6 of the forces.
   const NodeArray gradient = energyGradientForces(scene, 1e-6);
   const double scale = applied.cwiseAbs().maxCoeff();
@@ -199,7 +204,7 @@ TEST(Energy, ACompliantDistanceConstraintStoresHalfItsViolationSquaredOverItsCom
   const double alpha = 1e-3;
   body.constraints = { ConstraintDef{ 0, 1, alpha, 0.1 }, ConstraintDef{ 1, 2, alpha, 0.1 } };
   const SceneDef scene = sceneOf({ body }, IntegratorType::Xpbd, 0.01);
-  const World world = buildWorld(scene);
+  const World world = buildWorld(scene);  // as placed: both links stretched or squeezed off their 0.1 m
   double expected = 0.0;
   for (const auto& [a, b] : { std::pair{ 0, 1 }, std::pair{ 1, 2 } })
   {
@@ -207,7 +212,7 @@ TEST(Energy, ACompliantDistanceConstraintStoresHalfItsViolationSquaredOverItsCom
     expected += violation * violation / (2.0 * alpha);
   }
   EXPECT_NEAR(world.energy(), expected, 1e-12 * expected);
-  const NodeArray applied = appliedForces(scene);
+  const NodeArray applied = appliedForces(scene, 1e-6);
   EXPECT_TRUE(test::expectNear(energyGradientForces(scene, 1e-7), applied, 1e-5 * applied.cwiseAbs().maxCoeff()));
 }
 
