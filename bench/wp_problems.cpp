@@ -9,7 +9,7 @@
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/jelly.h"
 #include "soft_body_sim/core/bodies/rod.h"
-#include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/elements/forces.h"
 
 namespace soft_body_sim::bench
 {

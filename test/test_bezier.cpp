@@ -1,7 +1,7 @@
 // Quadratic Bezier point and tangent against hand-computed values and finite differences.
 #include <gtest/gtest.h>
 
-#include "soft_body_sim/core/bezier.h"
+#include "soft_body_sim/core/bodies/bezier.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test

@@ -1,4 +1,4 @@
-// Colliders (colliders.h, contact.h): each shape's distance, normal and closest point against a brute-force
+// Colliders (colliders.h, contact_stage.h): each shape's distance, normal and closest point against a brute-force
 // reference; Coulomb friction on a tilted box against the closed form of a block on an incline; a
 // conveyor dragging a node by friction relative to its own motion; a rope with two loads over a capsule
 // against the capstan equation; a cloth dropped onto a sphere kept outside it by its thickness.
@@ -13,8 +13,8 @@
 
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
-#include "../src/core/shape_contacts.h"
-#include "soft_body_sim/core/contact.h"
+#include "core/contact/shape_contacts.h"
+#include "soft_body_sim/core/contact/contact_stage.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test

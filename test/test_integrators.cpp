@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/elements/forces.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test

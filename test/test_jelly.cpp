@@ -21,7 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "soft_body_sim/core/bodies/jelly.h"
-#include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/elements/forces.h"
 #include "soft_body_sim/core/stability.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "soft_body_sim/tools/simulate.h"

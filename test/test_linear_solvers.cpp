@@ -14,9 +14,9 @@
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "../src/core/integrators/block_tridiagonal_solver.h"
-#include "../src/core/integrators/integrator_kit.h"
-#include "../src/core/integrators/sparse_block_solver.h"
+#include "core/solvers/block_tridiagonal_solver.h"
+#include "core/integrators/integrator_kit.h"
+#include "core/solvers/sparse_block_solver.h"
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/world.h"

@@ -10,7 +10,7 @@
 
 #include <gtest/gtest.h>
 
-#include "../src/core/shape_contacts.h"
+#include "core/contact/shape_contacts.h"
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/definition_error.h"

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 
 namespace soft_body_sim::test
 {

@@ -10,7 +10,7 @@
 #include "catenary.h"
 #include "soft_body_sim/core/bodies/jelly.h"
 #include "soft_body_sim/core/bodies/rope.h"
-#include "soft_body_sim/core/integrator_groups.h"
+#include "soft_body_sim/core/integrators/integrator_groups.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test

@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/ros/robot_colliders.h"
 #include "test_util.h"
 

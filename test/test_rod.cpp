@@ -11,7 +11,7 @@
 
 #include "elastica.h"
 #include "soft_body_sim/core/bodies/rod.h"
-#include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/elements/rods.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test

@@ -9,7 +9,7 @@
 
 #include "catenary.h"
 #include "soft_body_sim/core/bodies/rope.h"
-#include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/elements/forces.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "test_util.h"
 #include "scene_error.h"

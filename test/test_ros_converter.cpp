@@ -9,8 +9,8 @@
 #include "soft_body_sim/core/bodies/humanoid.h"
 #include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/bodies/rope.h"
-#include "soft_body_sim/core/mesh_field.h"
-#include "soft_body_sim/core/tetrahedra.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 #include "soft_body_sim/ros/ros_converter.h"
 #include "test_util.h"
 

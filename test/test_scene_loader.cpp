@@ -2,8 +2,8 @@
 // a one-line message "<source>:<line>: <key path>: <reason>" that points at the offending value.
 #include "soft_body_sim/scene/scene_loader.h"
 #include "scene_error.h"
-#include "soft_body_sim/core/contact.h"
-#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/contact/contact_stage.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 
 #include <gtest/gtest.h>
 

@@ -17,7 +17,7 @@
 #include "soft_body_sim/core/bodies/cloth.h"
 #include "soft_body_sim/core/bodies/rod.h"
 #include "soft_body_sim/core/bodies/rope.h"
-#include "soft_body_sim/core/self_contacts.h"
+#include "soft_body_sim/core/contact/self_contacts.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "test_util.h"
 

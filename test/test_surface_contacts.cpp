@@ -11,8 +11,8 @@
 
 #include "soft_body_sim/core/bodies/rope.h"
 #include "soft_body_sim/core/bodies/volume.h"
-#include "soft_body_sim/core/surface_contacts.h"
-#include "soft_body_sim/core/tetrahedra.h"
+#include "core/contact/surface_contacts.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test

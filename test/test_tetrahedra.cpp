@@ -9,7 +9,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "soft_body_sim/core/tetrahedra.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 
 namespace soft_body_sim::test
 {
@@ -45,9 +45,9 @@ Matrix12 assembled(const TetStiffness& k)
   Matrix12 m;
   for (int a = 0; a < 4; ++a)
     m.block<3, 3>(3 * a, 3 * a) = k.blocks[a];
-  for (std::size_t p = 0; p < kTetPairs.size(); ++p)
+  for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
   {
-    const int a = kTetPairs[p].first, b = kTetPairs[p].second;
+    const int a = kFourNodePairs[p].first, b = kFourNodePairs[p].second;
     m.block<3, 3>(3 * a, 3 * b) = k.blocks[4 + p];
     m.block<3, 3>(3 * b, 3 * a) = k.blocks[4 + p].transpose();
   }

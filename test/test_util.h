@@ -8,11 +8,12 @@
 
 #include <gtest/gtest.h>
 
+#include "core/elements/element_kinds.h"
 #include "soft_body_sim/core/bodies/volume.h"
-#include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/elements/rods.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/core/stability.h"
-#include "soft_body_sim/core/tetrahedra.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 
 namespace soft_body_sim::test
 {
@@ -61,8 +62,7 @@ inline std::vector<IntegratorType> stableIntegrators(const SceneDef& scene)
     integratorFromName(name, with.physics.integrator);
     try
     {
-      requireRodIntegrator(model, with.physics.integrator);
-      requireVolumeIntegrator(model, with.physics.integrator);
+      requireIntegratorRunsModel(model, with.physics.integrator);
     }
     catch (const std::invalid_argument&)
     {

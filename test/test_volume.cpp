@@ -12,7 +12,7 @@
 
 #include "soft_body_sim/core/bodies/volume.h"
 #include "soft_body_sim/core/scene_def.h"
-#include "soft_body_sim/core/tetrahedra.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 #include "test_util.h"
 
 namespace soft_body_sim::test

@@ -15,7 +15,7 @@
 
 #include <gtest/gtest.h>
 
-#include "soft_body_sim/core/bodies/volume_mesh.h"
+#include "soft_body_sim/core/meshing/volume_mesh.h"
 #include "soft_body_sim/core/definition_error.h"
 
 namespace soft_body_sim::test

@@ -7,7 +7,7 @@
 #include <stdexcept>
 #include <utility>
 
-#include "soft_body_sim/core/names.h"
+#include "core/names.h"
 
 namespace soft_body_sim
 {

@@ -8,9 +8,11 @@
 
 #include "soft_body_sim/core/stability.h"
 
-#include "soft_body_sim/core/forces.h"
-#include "soft_body_sim/core/rods.h"
-#include "soft_body_sim/core/tetrahedra.h"
+#include "core/elements/element_kinds.h"
+
+#include "soft_body_sim/core/elements/forces.h"
+#include "soft_body_sim/core/elements/rods.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 
 namespace soft_body_sim
 {
@@ -219,8 +221,7 @@ World buildWorld(const SceneDef& scene)
   }
   try
   {
-    requireRodIntegrator(model, scene.physics.integrator);
-    requireVolumeIntegrator(model, scene.physics.integrator);
+    requireIntegratorRunsModel(model, scene.physics.integrator);
   }
   catch (const std::invalid_argument& e)
   {

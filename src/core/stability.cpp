@@ -6,7 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/elements/forces.h"
 
 namespace soft_body_sim
 {

@@ -6,9 +6,10 @@
 #include <string>
 #include <utility>
 
-#include "soft_body_sim/core/forces.h"
-#include "soft_body_sim/core/rods.h"
-#include "soft_body_sim/core/tetrahedra.h"
+#include "core/elements/element_kinds.h"
+#include "soft_body_sim/core/elements/forces.h"
+#include "soft_body_sim/core/elements/rods.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 
 namespace soft_body_sim
 {
@@ -173,8 +174,7 @@ std::string World::treatDiverged(std::size_t body)
 
 void World::setIntegrator(IntegratorType type)
 {
-  requireRodIntegrator(model_, type);
-  requireVolumeIntegrator(model_, type);
+  requireIntegratorRunsModel(model_, type);
   integrators_.setAll(type);
 }
 
@@ -310,10 +310,7 @@ InternalForces World::internalForces() const
 NodeArray World::pulls() const
 {
   NodeArray pull;
-  internalPulls(model_, state_.position, internalForces(), pull);
-  for (const Rod& rod : model_.rods)
-    accumulateRodForces(rod, state_.position, state_.twist, pull);
-  accumulateTetForces(model_, state_.position, pull);
+  internalPulls(model_, state_, internalForces(), pull);
   return pull;
 }
 

@@ -7,7 +7,7 @@
 #include <urdf/model.h>
 
 #include "soft_body_sim/core/definition_error.h"
-#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/scene/mesh_uri.h"
 
 namespace soft_body_sim

@@ -4,7 +4,7 @@
 #include <array>
 #include <cmath>
 
-#include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/elements/rods.h"
 
 namespace soft_body_sim
 {

@@ -6,7 +6,7 @@
 #include <std_msgs/Time.h>
 
 #include "soft_body_sim/SimState.h"
-#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/ros/robot_colliders.h"
 #include "soft_body_sim/scene/scene_loader.h"
 

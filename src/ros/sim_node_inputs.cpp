@@ -10,7 +10,7 @@
 
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
-#include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/elements/rods.h"
 #include "soft_body_sim/ros/sim_node.h"
 
 namespace soft_body_sim

@@ -4,7 +4,7 @@
 
 #include <ros/names.h>
 
-#include "soft_body_sim/core/forces.h"
+#include "soft_body_sim/core/elements/forces.h"
 #include "soft_body_sim/ros/sim_node.h"
 
 namespace soft_body_sim

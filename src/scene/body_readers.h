@@ -9,10 +9,10 @@
 #include <string>
 #include <vector>
 
-#include "soft_body_sim/core/controller.h"
-#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/bodies/controller.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/core/scene_def.h"
-#include "yaml_reader.h"
+#include "scene/yaml_reader.h"
 
 namespace soft_body_sim
 {

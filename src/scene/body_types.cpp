@@ -1,4 +1,4 @@
-#include "body_readers.h"
+#include "scene/body_readers.h"
 
 namespace soft_body_sim::scene_yaml
 {

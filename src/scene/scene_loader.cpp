@@ -8,10 +8,10 @@
 #include <set>
 #include <utility>
 
-#include "body_readers.h"
-#include "soft_body_sim/core/mesh_field.h"
+#include "scene/body_readers.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/scene/mesh_uri.h"
-#include "yaml_reader.h"
+#include "scene/yaml_reader.h"
 
 namespace soft_body_sim
 {

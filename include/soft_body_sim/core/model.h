@@ -12,7 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "soft_body_sim/core/colliders.h"
+#include "soft_body_sim/core/contact/colliders.h"
 
 namespace soft_body_sim
 {

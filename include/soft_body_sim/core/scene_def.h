@@ -8,10 +8,10 @@
 #include <utility>
 #include <vector>
 
-#include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/bodies/controller.h"
 #include "soft_body_sim/core/definition_error.h"
 #include "soft_body_sim/core/guard.h"
-#include "soft_body_sim/core/integrator.h"
+#include "soft_body_sim/core/integrators/integrator.h"
 #include "soft_body_sim/core/model.h"
 #include "soft_body_sim/core/world.h"
 

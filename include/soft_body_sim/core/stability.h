@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "soft_body_sim/core/integrator.h"
+#include "soft_body_sim/core/integrators/integrator.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim

@@ -10,17 +10,17 @@
 #include <utility>
 #include <vector>
 
-#include "soft_body_sim/core/anchors.h"
-#include "soft_body_sim/core/contact.h"
-#include "soft_body_sim/core/controller.h"
-#include "soft_body_sim/core/grasps.h"
+#include "soft_body_sim/core/holding/anchors.h"
+#include "soft_body_sim/core/contact/contact_stage.h"
+#include "soft_body_sim/core/bodies/controller.h"
+#include "soft_body_sim/core/holding/grasps.h"
 #include "soft_body_sim/core/guard.h"
-#include "soft_body_sim/core/integrator.h"
-#include "soft_body_sim/core/integrator_groups.h"
-#include "soft_body_sim/core/material.h"
+#include "soft_body_sim/core/integrators/integrator.h"
+#include "soft_body_sim/core/integrators/integrator_groups.h"
+#include "soft_body_sim/core/material_scaling.h"
 #include "soft_body_sim/core/model.h"
-#include "soft_body_sim/core/reactions.h"
-#include "soft_body_sim/core/self_contacts.h"
+#include "soft_body_sim/core/holding/reactions.h"
+#include "soft_body_sim/core/contact/self_contacts.h"
 
 namespace soft_body_sim
 {

@@ -5,7 +5,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "soft_body_sim/core/bodies/volume_mesh.h"
+#include "soft_body_sim/core/meshing/volume_mesh.h"
 #include "soft_body_sim/core/scene_def.h"
 
 namespace soft_body_sim

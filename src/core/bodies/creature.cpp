@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>  // cross products
 
-#include "fixed_period_clock.h"
+#include "core/bodies/fixed_period_clock.h"
 #include "soft_body_sim/core/bodies/rope.h"
 
 namespace soft_body_sim

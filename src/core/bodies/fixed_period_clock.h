@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "soft_body_sim/core/controller.h"
+#include "soft_body_sim/core/bodies/controller.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim

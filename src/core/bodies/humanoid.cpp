@@ -6,7 +6,7 @@
 
 #include <Eigen/Geometry>  // cross products
 
-#include "fixed_period_clock.h"
+#include "core/bodies/fixed_period_clock.h"
 
 namespace soft_body_sim
 {

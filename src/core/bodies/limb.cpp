@@ -3,7 +3,7 @@
 #include <memory>
 #include <stdexcept>
 
-#include "fixed_period_clock.h"
+#include "core/bodies/fixed_period_clock.h"
 
 namespace soft_body_sim
 {

@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "soft_body_sim/core/rods.h"
+#include "soft_body_sim/core/elements/rods.h"
 
 namespace soft_body_sim
 {

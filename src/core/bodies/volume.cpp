@@ -4,8 +4,8 @@
 #include <cmath>
 #include <string>
 
-#include "soft_body_sim/core/bodies/volume_mesh.h"
-#include "soft_body_sim/core/tetrahedra.h"
+#include "soft_body_sim/core/meshing/volume_mesh.h"
+#include "soft_body_sim/core/elements/tetrahedra.h"
 
 namespace soft_body_sim
 {

@@ -1,4 +1,4 @@
-#include "chain_contacts.h"
+#include "core/integrators/chain_contacts.h"
 
 #include <algorithm>
 #include <cmath>

@@ -5,7 +5,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "chain_solver.h"
+#include "core/solvers/chain_solver.h"
 
 namespace soft_body_sim
 {
@@ -22,7 +22,7 @@ struct ChainPath
 ///
 /// Why inside: a rope carrying a load over a collider (a cable over a pulley, the capstan) is held by
 /// friction on its light nodes, and the load at its end feels that friction only through the rope's
-/// tension. The contact stage after the solve (contact.h) can stop a node only at the node's own mass;
+/// tension. The contact stage after the solve (contact_stage.h) can stop a node only at the node's own mass;
 /// the next solve, which carries the load, moves it on. Measured on a 42 g rope with 0.5 kg loads over
 /// a capsule with friction 0.3: the loads ran as if the capsule were frictionless.
 ///

@@ -3,9 +3,9 @@
 
 #include <memory>
 
-#include "soft_body_sim/core/constraints.h"
-#include "soft_body_sim/core/forces.h"
-#include "soft_body_sim/core/integrator.h"
+#include "core/elements/distance_constraints.h"
+#include "soft_body_sim/core/elements/forces.h"
+#include "soft_body_sim/core/integrators/integrator.h"
 
 namespace soft_body_sim
 {
@@ -29,7 +29,7 @@ inline SweepRow sweepRow(const ConstraintRow& row, const Eigen::VectorXd& invers
   return SweepRow{ row.a, row.b, row.rest_length, row.alpha_tilde, row.gamma, inverse };
 }
 
-/// The XPBD update of one ConstraintRow (constraints.h), inline for the integrators' sweeps. Its cost is bounded
+/// The XPBD update of one ConstraintRow (distance_constraints.h), inline for the integrators' sweeps. Its cost is bounded
 /// by the divider, so it takes one square root and one division per update: u = d (1 / |d|) rather
 /// than three divisions, and the denominator's reciprocal from the row.
 [[gnu::always_inline]] inline void projectDistance(const SweepRow& row, const Eigen::VectorXd& inverse_mass,

@@ -1,5 +1,5 @@
-#include "integrator_kit.h"
-#include "soft_body_sim/core/forces.h"
+#include "core/integrators/integrator_kit.h"
+#include "soft_body_sim/core/elements/forces.h"
 
 namespace soft_body_sim
 {

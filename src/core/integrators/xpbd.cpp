@@ -3,10 +3,10 @@
 #include <utility>
 #include <vector>
 
-#include "chain_contacts.h"
-#include "chain_solver.h"
-#include "integrator_kit.h"
-#include "soft_body_sim/core/forces.h"
+#include "core/integrators/chain_contacts.h"
+#include "core/solvers/chain_solver.h"
+#include "core/integrators/integrator_kit.h"
+#include "soft_body_sim/core/elements/forces.h"
 
 namespace soft_body_sim
 {

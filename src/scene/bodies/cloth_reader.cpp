@@ -1,5 +1,5 @@
 // `type: cloth` (tum-mass-spring-tutorial.txt): a grid of nx x ny nodes spanning three corners.
-#include "generated_body_keys.h"
+#include "scene/bodies/generated_body_keys.h"
 
 namespace soft_body_sim::scene_yaml
 {

@@ -1,7 +1,7 @@
 // `type: creature`: the codeling of fuzzy-physics-constraints.txt (see core/bodies/creature.h).
 #include <sstream>
 
-#include "../body_readers.h"
+#include "scene/body_readers.h"
 #include "soft_body_sim/core/bodies/creature.h"
 
 namespace soft_body_sim::scene_yaml

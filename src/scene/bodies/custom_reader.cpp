@@ -1,5 +1,5 @@
 // `type: custom`: nodes, springs and constraints listed one by one.
-#include "../body_readers.h"
+#include "scene/body_readers.h"
 
 namespace soft_body_sim::scene_yaml
 {

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "../body_readers.h"
+#include "scene/body_readers.h"
 #include "soft_body_sim/core/bodies/cloth.h"
 
 namespace soft_body_sim::scene_yaml

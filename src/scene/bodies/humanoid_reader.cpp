@@ -3,7 +3,7 @@
 
 #include <Eigen/Geometry>  // cross products
 
-#include "../body_readers.h"
+#include "scene/body_readers.h"
 #include "soft_body_sim/core/bodies/humanoid.h"
 
 namespace soft_body_sim::scene_yaml

@@ -1,5 +1,5 @@
 // `type: jelly` (springy-viscous-jelly.txt): nx x ny gas-filled cells spanning three corners.
-#include "generated_body_keys.h"
+#include "scene/bodies/generated_body_keys.h"
 #include "soft_body_sim/core/bodies/jelly.h"
 
 namespace soft_body_sim::scene_yaml

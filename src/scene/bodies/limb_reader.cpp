@@ -1,7 +1,7 @@
 // `type: limb`: one 3-particle Verlet limb of verlet-bezier-limbs.txt (see core/bodies/limb.h), and the
 // limb-motion keys it shares with `humanoid`.
 
-#include "../body_readers.h"
+#include "scene/body_readers.h"
 #include "soft_body_sim/core/bodies/limb.h"
 
 namespace soft_body_sim::scene_yaml

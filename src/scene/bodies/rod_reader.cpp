@@ -1,5 +1,5 @@
 // `type: rod`: a cable, hose or wire by its material (bodies/rod.h), straight from `from` to `to`.
-#include "generated_body_keys.h"
+#include "scene/bodies/generated_body_keys.h"
 #include "soft_body_sim/core/bodies/rod.h"
 
 namespace soft_body_sim::scene_yaml

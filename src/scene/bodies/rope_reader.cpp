@@ -1,6 +1,6 @@
 // `type: rope` (spring-string-tutorial.txt): a chain of equal-mass nodes, straight from `from` to `to`
 // or along a `path`.
-#include "generated_body_keys.h"
+#include "scene/bodies/generated_body_keys.h"
 #include "soft_body_sim/core/bodies/rope.h"
 
 namespace soft_body_sim::scene_yaml

@@ -1,6 +1,6 @@
 // `type: volume`: a soft solid, a box, a ball or a closed surface file filled with tetrahedra
 // (bodies/volume.h).
-#include "../body_readers.h"
+#include "scene/body_readers.h"
 #include "soft_body_sim/core/bodies/volume.h"
 
 namespace soft_body_sim::scene_yaml

@@ -17,7 +17,7 @@
 
 #include <string>
 
-#include "soft_body_sim/core/bezier.h"
+#include "soft_body_sim/core/bodies/bezier.h"
 #include "soft_body_sim/core/scene_def.h"
 
 namespace soft_body_sim

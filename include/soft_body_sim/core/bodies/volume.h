@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
-#include "soft_body_sim/core/bodies/volume_mesh.h"
-#include "soft_body_sim/core/mesh_field.h"
+#include "soft_body_sim/core/meshing/volume_mesh.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/core/scene_def.h"
 
 namespace soft_body_sim

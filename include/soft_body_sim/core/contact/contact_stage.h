@@ -1,0 +1,181 @@
+// The contact stage of a step: after each sub-step's integration, every kind of collider the scene
+// declares (colliders.h) pushes the free nodes, with their contact radius, out of its shapes and changes
+// their velocities (bounce, friction relative to the shape's own motion). Solves that take contact into
+// themselves (xpbd's chains) ask it where a node touches through ContactQuery. A new kind is its shape struct
+// in colliders.h, its ColliderKind in its own file (or a surfaceDistance for ShapeContacts), one line in
+// makeColliderKinds (contact_stage.cpp) and its reader: nothing in World. A scene that declares no colliders
+// has no kinds here and pays nothing.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "soft_body_sim/core/integrators/integrator.h"
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+/// Where a drawable collider is now, and its extents.
+struct ColliderPose
+{
+  enum class Shape
+  {
+    Sphere,
+    Capsule,
+    Box,
+    Cylinder,
+    Mesh
+  };
+  std::string name;
+  Shape shape = Shape::Sphere;
+  Vec3 position = Vec3::Zero();                                   ///< [m] of its origin
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+  /// [m] sphere: its diameter three times; capsule and cylinder: (2 radius, 2 radius, length); box: its size;
+  /// mesh: its scale [-] (the file's coordinates are metres).
+  Vec3 size = Vec3::Zero();
+  std::string mesh;  ///< a mesh's file as rviz loads it (Mesh::uri: package:// or file://); else empty
+
+  static ColliderPose of(const Sphere& s) { return { s.at.name, Shape::Sphere, s.at.position, s.at.orientation, Vec3::Constant(2.0 * s.radius), {} }; }
+  static ColliderPose of(const Capsule& c)
+  {
+    return { c.at.name, Shape::Capsule, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {} };
+  }
+  static ColliderPose of(const Box& b) { return { b.at.name, Shape::Box, b.at.position, b.at.orientation, b.size, {} }; }
+  static ColliderPose of(const Cylinder& c)
+  {
+    return { c.at.name, Shape::Cylinder, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {} };
+  }
+  static ColliderPose of(const Mesh& m) { return { m.at.name, Shape::Mesh, m.at.position, m.at.orientation, m.scale, m.uri }; }
+};
+
+/// A rigid pose: position [m] and orientation (unit quaternion) of a collider's origin and axes.
+struct RigidPose
+{
+  Vec3 position = Vec3::Zero();
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+};
+
+/// Where a collider should be at simulated time t [s]; nullopt = not known (it then holds still).
+using ColliderPath = std::function<std::optional<RigidPose>(double t)>;
+
+/// One kind of collider, over all of its shapes in the model.
+class ColliderKind
+{
+public:
+  virtual ~ColliderKind() = default;
+  /// After a sub-step of h [s] that took the nodes from `start` [m] to state.position: moves its shapes
+  /// by h and resolves the contacts of every free node with them. True if it touched any node (the
+  /// integrators' caches of the state are then stale).
+  virtual bool resolve(const Model& model, const NodeArray& start, State& state, double h) = 0;
+  /// ContactQuery::touching over its shapes (as they are before this sub-step's resolve moves them).
+  virtual bool touching(const Model& /*model*/, int /*node*/, const Vec3& /*x*/, double /*margin*/,
+                        NodeContact& /*contact*/) const
+  {
+    return false;
+  }
+  /// Appends the current pose of each of its drawable shapes (planes are infinite: none).
+  virtual void appendPoses(std::vector<ColliderPose>& /*poses*/) const {}
+  /// Moves its shape `name` to `goal` over the next dt [s] at constant linear and angular velocity (its
+  /// velocities for friction); nullopt: it holds still. False if it has no shape of that name.
+  virtual bool setGoal(const std::string& /*name*/, const std::optional<RigidPose>& /*goal*/, double /*dt*/)
+  {
+    return false;
+  }
+  /// At a step's end: the shapes that had a goal sit exactly on it.
+  virtual void land() {}
+};
+
+/// The kinds of collider that `model` declares, in the order they resolve. Throws std::invalid_argument
+/// on a collider that its kind rejects.
+std::vector<std::unique_ptr<ColliderKind>> makeColliderKinds(const Model& model);
+
+class ContactStage final : public ContactQuery
+{
+public:
+  explicit ContactStage(const Model& model) : kinds_(makeColliderKinds(model)) {}
+
+  /// What the integrators' solves may ask (null without colliders: they pay nothing).
+  const ContactQuery* query() const { return kinds_.empty() ? nullptr : this; }
+
+  bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const override
+  {
+    bool found = false;
+    NodeContact candidate;
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      if (kind->touching(model, node, x, margin, candidate) && (!found || candidate.depth > contact.depth))
+      {
+        contact = candidate;
+        found = true;
+      }
+    return found;
+  }
+
+  /// Before a sub-step's integration: keeps where the nodes start (friction acts on the sub-step's
+  /// displacement). Nothing without colliders.
+  void remember(const State& state)
+  {
+    if (!kinds_.empty())
+      start_ = state.position;
+  }
+
+  /// Every kind in turn; true if any touched a node.
+  bool resolve(const Model& model, State& state, double h)
+  {
+    bool touched = false;
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      touched = kind->resolve(model, start_, state, h) || touched;
+    return touched;
+  }
+
+  /// The current pose of every drawable collider.
+  std::vector<ColliderPose> poses() const
+  {
+    std::vector<ColliderPose> poses;
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      kind->appendPoses(poses);
+    return poses;
+  }
+
+  /// Moves collider `name` to `goal` over the next dt [s]; false if there is none of that name.
+  bool setGoal(const std::string& name, const std::optional<RigidPose>& goal, double dt)
+  {
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      if (kind->setGoal(name, goal, dt))
+        return true;
+    return false;
+  }
+
+  /// Collider `name` follows `path` from the next step on (setGoal to path(t) at every step's end time
+  /// t); false if there is none of that name.
+  bool followPath(const std::string& name, ColliderPath path)
+  {
+    if (!setGoal(name, std::nullopt, 1.0))
+      return false;
+    paths_.emplace_back(name, std::move(path));
+    return true;
+  }
+
+  /// At a step's start: every collider with a path heads for where it will be at `end_time` [s].
+  void goalsFromPaths(double end_time, double dt)
+  {
+    for (const auto& [name, path] : paths_)
+      setGoal(name, path(end_time), dt);
+  }
+
+  /// At a step's end: every collider that had a goal sits on it.
+  void land()
+  {
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      kind->land();
+  }
+
+private:
+  std::vector<std::unique_ptr<ColliderKind>> kinds_;
+  NodeArray start_;  ///< positions before the current sub-step's integration [m]
+  std::vector<std::pair<std::string, ColliderPath>> paths_;
+};
+
+}  // namespace soft_body_sim

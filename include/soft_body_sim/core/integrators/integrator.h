@@ -1,0 +1,87 @@
+// Time integrators. Each advances the same physical model (springs, dashpots, gravity, drag,
+// distance constraints) by one (sub)step h, so that their results can be compared.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+enum class IntegratorType
+{
+  ExplicitEuler,
+  SemiImplicitEuler,
+  Verlet,
+  VelocityVerlet,
+  Rk4,
+  ImplicitEuler,
+  Xpbd,
+};
+
+/// The scene-file name of each integrator, e.g. "semi_implicit_euler".
+std::string integratorName(IntegratorType type);
+/// Parses a scene-file name; false if the name is unknown.
+bool integratorFromName(const std::string& name, IntegratorType& type);
+/// Every valid name, in declaration order.
+const std::vector<std::string>& integratorNames();
+
+/// A node within its contact radius of a collider's surface, as a solve sees it (ContactQuery).
+struct NodeContact
+{
+  Vec3 normal;            ///< the surface's outward unit normal
+  Vec3 velocity;          ///< [m/s] of the surface point (0 for a fixed collider)
+  double friction = 0.0;  ///< Coulomb coefficient [-]
+  double depth = 0.0;     ///< [m] how far the node is inside its contact radius (< 0: that far outside it)
+};
+
+/// The colliders as a solve can ask about them (the contact stage, contact_stage.h).
+class ContactQuery
+{
+public:
+  virtual ~ContactQuery() = default;
+  /// The surface nearest to node `node` placed at `x` [m], if it is within the node's contact radius
+  /// plus `margin` [m] of one; the deepest if several are.
+  virtual bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const = 0;
+};
+
+/// The forces inside the bodies in the last sub-step, as an integrator's solve had them.
+struct InternalForces
+{
+  Eigen::VectorXd tension;   ///< [N] per spring, then per distance constraint (model order), > 0 stretched
+  Eigen::VectorXd pressure;  ///< [N/m] per pressure cell (PressureCell), > 0 pushing its outline out
+};
+
+class Integrator
+{
+public:
+  virtual ~Integrator() = default;
+  /// Advances `state` by h [s]. Pinned nodes (inverse mass 0) are never moved: their position and
+  /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
+  virtual void step(const Model& model, State& state, double h, int iterations) = 0;
+  /// step(), where the scene has colliders (`contacts`; null: none). A solve that can take contacts into
+  /// it does (xpbd's chains: chain_contacts.h); the others leave them to the contact stage that follows.
+  virtual void stepWithContacts(const Model& model, State& state, double h, int iterations,
+                                const ContactQuery* /*contacts*/)
+  {
+    step(model, state, h, iterations);
+  }
+  /// The forces inside the bodies in the last sub-step: each link's tension (it pulls each end toward the
+  /// other with that force) and each cell's gas pressure. The force-based schemes take the spring and gas
+  /// laws at `state` and, for constraints, their constraint pass's multipliers as forces -lambda / h^2;
+  /// xpbd takes its multipliers for all three. Before the first step: the laws at `state`, and 0 for
+  /// constraints.
+  virtual void internalForces(const Model& model, const State& state, InternalForces& forces) const = 0;
+  /// The state was changed from outside the integrator (an anchor or controller moved its nodes, a
+  /// plane contact changed a velocity, a node was set): drop anything cached from the old state.
+  virtual void invalidate() {}
+  /// The model was changed (gravity, drag, stiffness, pressure, a node pinned or released): drop anything
+  /// cached from the old model as well as from the old state.
+  virtual void modelChanged() { invalidate(); }
+};
+
+std::unique_ptr<Integrator> makeIntegrator(IntegratorType type);
+
+}  // namespace soft_body_sim

@@ -1,0 +1,41 @@
+// Live material: what each body was built with, and the factors a user turns on it while the scene runs
+// (the jelly seed's sliders "to make it more springy or viscous"). The factors multiply the built values,
+// so they never compound and 1 restores the scene.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+/// Live multipliers of one body's material, relative to the scene's values. 1 = as loaded; each > 0.
+struct BodyScaling
+{
+  double stiffness = 1.0;  ///< [-] spring stiffness k, constraint stiffness 1 / compliance, a rod's E I and G J, a solid's E
+  double damping = 1.0;    ///< [-] spring dashpots c, a rod's damping beta
+  double pressure = 1.0;   ///< [-] rest gas pressure p0 of the body's cells and tetrahedra
+};
+
+class MaterialScaling
+{
+public:
+  /// Keeps `built`'s elements (every kind's) as the values the factors multiply.
+  explicit MaterialScaling(const Model& built);
+
+  /// Writes body `body`'s elements into `model` as built times `scaling` (each kind's scale). Throws
+  /// std::invalid_argument if a factor is out of range (see BodyScaling) and changes nothing then.
+  void set(Model& model, std::size_t body, const BodyScaling& scaling);
+  /// The scaling last set for body `body` (all 1 if never set).
+  const BodyScaling& of(std::size_t body) const { return scaling_.at(body); }
+  /// True if body `body` was built with elements of any kind: a material to scale.
+  bool has(std::size_t body) const { return has_material_.at(body) != 0; }
+
+private:
+  Model built_;  ///< the elements as built (its element arrays only)
+  std::vector<BodyScaling> scaling_;  ///< per body
+  std::vector<char> has_material_;    ///< per body
+};
+
+}  // namespace soft_body_sim

@@ -1,0 +1,38 @@
+#include "soft_body_sim/core/contact/contact_stage.h"
+
+#include "core/contact/shape_contacts.h"
+#include "core/contact/planes.h"
+#include "soft_body_sim/core/contact/mesh_field.h"
+
+namespace soft_body_sim
+{
+namespace
+{
+template <typename Shape>
+void addShapes(std::vector<std::unique_ptr<ColliderKind>>& kinds, const std::vector<Shape>& shapes, int nodes)
+{
+  if (!shapes.empty())
+    kinds.push_back(std::make_unique<ShapeContacts<Shape>>(shapes, nodes));
+}
+}  // namespace
+
+std::vector<std::unique_ptr<ColliderKind>> makeColliderKinds(const Model& model)
+{
+  std::vector<std::unique_ptr<ColliderKind>> kinds;
+  if (!model.colliders.planes.empty())
+    kinds.push_back(std::make_unique<PlaneContacts>(model.colliders.planes, model.nodeCount()));
+  addShapes(kinds, model.colliders.spheres, model.nodeCount());
+  addShapes(kinds, model.colliders.capsules, model.nodeCount());
+  addShapes(kinds, model.colliders.boxes, model.nodeCount());
+  addShapes(kinds, model.colliders.cylinders, model.nodeCount());
+  if (!model.colliders.meshes.empty())
+  {
+    // Their distance fields reach as far out as the thickest node needs.
+    std::vector<Mesh> meshes = model.colliders.meshes;
+    buildMeshFields(meshes, model.nodeCount() > 0 ? model.contact_radius.maxCoeff() : 0.0);
+    addShapes(kinds, meshes, model.nodeCount());
+  }
+  return kinds;
+}
+
+}  // namespace soft_body_sim

@@ -1,0 +1,57 @@
+// Contact with the scene's planes (walls and floors): the contact stage's first kind of collider.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "soft_body_sim/core/contact/contact_stage.h"
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+/// Pushes every free node that is behind a plane (closer than its contact radius) back onto it and, if
+/// it was moving into the plane, takes away its normal velocity, applies Coulomb friction (leaveSurface,
+/// contact_response.h) and, on a new impact, bounces it with the plane's restitution. A plane is a
+/// half-space, so a fast node cannot tunnel through it.
+/// An impact is new when the node did not touch any plane in the previous sub-step (`touching`, one
+/// flag per node, updated here) and approaches faster than `resting_speed` [m/s]: a node resting on a
+/// floor, alone or under the weight of others, gains approach speed every step and must not jitter.
+/// Returns true if any node was touched.
+/// `planes` have unit normals; h [s] is the sub-step just taken, which started at `start` [m].
+bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, const NodeArray& start, State& state,
+                       double resting_speed, std::vector<std::uint8_t>& touching, double h);
+
+/// The scene's planes as a kind of collider of the contact stage.
+class PlaneContacts final : public ColliderKind
+{
+public:
+  /// Keeps the planes with unit normals; throws std::invalid_argument on a zero normal.
+  PlaneContacts(std::vector<Plane> planes, int nodes);
+
+  /// A node resting on a plane approaches it by ~|g| h per sub-step; twice that does not bounce.
+  bool resolve(const Model& model, const NodeArray& start, State& state, double h) override
+  {
+    return collideWithPlanes(planes_, model, start, state, 2.0 * model.gravity.norm() * h, touching_, h);
+  }
+
+  bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const override
+  {
+    bool found = false;
+    for (const Plane& plane : planes_)
+    {
+      const double depth = model.contact_radius[node] - (x - plane.point).dot(plane.normal);
+      if (depth > -margin && (!found || depth > contact.depth))
+      {
+        contact = NodeContact{ plane.normal, Vec3::Zero(), plane.friction, depth };
+        found = true;
+      }
+    }
+    return found;
+  }
+
+private:
+  std::vector<Plane> planes_;
+  std::vector<std::uint8_t> touching_;  ///< per node: on a plane after the last sub-step
+};
+
+}  // namespace soft_body_sim

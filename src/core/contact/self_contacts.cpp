@@ -1,0 +1,356 @@
+#include "soft_body_sim/core/contact/self_contacts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <tuple>
+
+namespace soft_body_sim
+{
+namespace
+{
+/// The parameters s, t in [0, 1] of the nearest points of segments p0 + s d1 and q0 + t d2 (Ericson,
+/// Real-Time Collision Detection, 5.1.9), or of the nearest among their ends and the other segment if
+/// the two are within ~10 degrees of parallel. A link lying along another (a rope in a groove, on a rope)
+/// then meets it at one of its nodes, each node pushed out by its own depth: a point inside the link
+/// (where the nearly parallel lines come closest, ill-conditioned) would push both nodes by the depth
+/// there, throwing out one that a neighbouring link had already freed, and that node, off the surface,
+/// would slip with no friction holding it.
+std::pair<double, double> contactParameters(const Vec3& p0, const Vec3& d1, const Vec3& q0, const Vec3& d2)
+{
+  const Vec3 r = p0 - q0;
+  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
+  if (!(a > 0.0) && !(e > 0.0))
+    return { 0.0, 0.0 };
+  if (!(a > 0.0))
+    return { 0.0, std::clamp(f / e, 0.0, 1.0) };
+  const double c = d1.dot(r);
+  if (!(e > 0.0))
+    return { std::clamp(-c / a, 0.0, 1.0), 0.0 };
+  const double b = d1.dot(d2), denominator = a * e - b * b;
+  if (denominator < 0.03 * a * e)  // sin^2 of the angle between them < 0.03
+  {
+    const std::pair<double, double> ends[4] = { { 0.0, std::clamp(f / e, 0.0, 1.0) },
+                                                { 1.0, std::clamp((b + f) / e, 0.0, 1.0) },
+                                                { std::clamp(-c / a, 0.0, 1.0), 0.0 },
+                                                { std::clamp((b - c) / a, 0.0, 1.0), 1.0 } };
+    std::pair<double, double> nearest = ends[0];
+    double least = 1e300;
+    for (const auto& [s, t] : ends)
+    {
+      const double gap = (r + s * d1 - t * d2).squaredNorm();
+      if (gap < least)
+      {
+        least = gap;
+        nearest = { s, t };
+      }
+    }
+    return nearest;
+  }
+  double s = std::clamp((b * f - c * e) / denominator, 0.0, 1.0);
+  double t = (b * s + f) / e;
+  if (t < 0.0)
+  {
+    t = 0.0;
+    s = std::clamp(-c / a, 0.0, 1.0);
+  }
+  else if (t > 1.0)
+  {
+    t = 1.0;
+    s = std::clamp((b - c) / a, 0.0, 1.0);
+  }
+  return { s, t };
+}
+
+/// The vector [m] from the contact point of `to`'s segment to that of `from`'s (contactParameters), and
+/// their parameters p (along `from`) and q (along `to`).
+Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::pair<int, int>& to, double& p,
+                double& q)
+{
+  if (from.first == from.second && to.first == to.second)
+  {
+    // Two balls (a cloth's or jelly's nodes): the general case's answer, without its work.
+    p = q = 0.0;
+    return x.col(from.first) - x.col(to.first);
+  }
+  const Vec3 xa = x.col(from.first), xc = x.col(to.first);
+  const Vec3 along_from = x.col(from.second) - xa, along_to = x.col(to.second) - xc;
+  std::tie(p, q) = contactParameters(xa, along_from, xc, along_to);
+  return (xa + p * along_from) - (xc + q * along_to);
+}
+
+/// A cell coordinate, kept far from the integer limits (a node at 1e300 m is a diverged one the guard
+/// deals with; here it only has to stay a valid index).
+std::int32_t cellCoordinate(double position, double cell)
+{
+  return static_cast<std::int32_t>(std::clamp(std::floor(position / cell), -1e9, 1e9));
+}
+}  // namespace
+
+std::int64_t SegmentGrid::slot(std::int64_t i, std::int64_t j, std::int64_t k) const
+{
+  const std::uint64_t hash = (static_cast<std::uint64_t>(i) * 73856093u) ^ (static_cast<std::uint64_t>(j) * 19349663u) ^
+                             (static_cast<std::uint64_t>(k) * 83492791u);
+  return static_cast<std::int64_t>(hash & (start_.size() - 2));  // the slot count is a power of two
+}
+
+void SegmentGrid::build(const NodeArray& x, const std::vector<std::pair<int, int>>& segments, double cell)
+{
+  const std::size_t count = segments.size();
+  std::size_t slots = 1;  // a power of two, at least twice the segments: a mask, not a division, per lookup
+  while (slots < 2 * count)
+    slots *= 2;
+  coordinate_.resize(3 * count);
+  slot_of_.resize(count);
+  sorted_.resize(count);
+  start_.assign(slots + 1, 0);
+  for (std::size_t s = 0; s < count; ++s)
+  {
+    const Vec3 middle = 0.5 * (x.col(segments[s].first) + x.col(segments[s].second));
+    for (int axis = 0; axis < 3; ++axis)
+      coordinate_[3 * s + static_cast<std::size_t>(axis)] = cellCoordinate(middle[axis], cell);
+    const std::int32_t* c = &coordinate_[3 * s];
+    slot_of_[s] = static_cast<std::uint32_t>(slot(c[0], c[1], c[2]));
+    ++start_[slot_of_[s] + 1];
+  }
+  for (std::size_t q = 0; q < slots; ++q)
+    start_[q + 1] += start_[q];
+  cursor_.assign(start_.begin(), start_.end() - 1);
+  for (std::size_t s = 0; s < count; ++s)
+    sorted_[cursor_[slot_of_[s]]++] = static_cast<std::uint32_t>(s);
+}
+
+SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
+{
+  if (model.contact_radius.size() != model.nodeCount())
+    return;  // a model made without radii (World gives it zeros): points, which do not collide
+  const auto add = [&](int a, int b, std::size_t body) {
+    const double radius = 0.5 * (model.contact_radius[a] + model.contact_radius[b]);
+    if (!model.bodies[body].self_collision || !(radius > 0.0))
+      return;
+    segments_.emplace_back(a, b);
+    body_.push_back(static_cast<int>(body));
+    radius_.push_back(radius);
+    friction_.push_back(model.bodies[body].self_friction);
+    any_friction_ = any_friction_ || model.bodies[body].self_friction > 0.0;
+    largest_radius_ = std::max(largest_radius_, radius);
+  };
+  std::vector<bool> has_links(model.bodies.size(), false);
+  for (const auto& [a, b] : model.contact_segments)
+  {
+    const std::size_t body = model.bodyOf(a);
+    has_links[body] = true;
+    add(a, b, body);
+  }
+  // A body without links (a cloth, a jelly) collides by its nodes, each a ball of its contact radius: a
+  // segment from the node to itself.
+  for (std::size_t body = 0; body < model.bodies.size(); ++body)
+    if (!has_links[body])
+      for (int i = model.bodies[body].first; i < model.bodies[body].first + model.bodies[body].count; ++i)
+        add(i, i, body);
+  // A jelly's springs too, which its nodes stay out of.
+  for (const Spring& spring : model.springs)
+  {
+    const std::size_t body = model.bodyOf(spring.a);
+    if (model.bodies[body].springs_collide)
+      add(spring.a, spring.b, body);
+  }
+  for (const BodyRange& body : model.bodies)
+    springs_collide_.push_back(body.springs_collide);
+  rest_.resize(3, static_cast<Eigen::Index>(segments_.size()));
+  for (std::size_t k = 0; k < segments_.size(); ++k)
+    rest_.col(static_cast<Eigen::Index>(k)) = rest.col(segments_[k].first);
+  middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
+  half_.assign(segments_.size(), 0.0);
+  for (const auto& [a, b] : segments_)
+    nodes_.insert(nodes_.end(), { a, b });
+  std::sort(nodes_.begin(), nodes_.end());
+  nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
+  skin_ = kSkinRadii * largest_radius_;
+}
+
+void SelfContacts::remember(const State& state)
+{
+  if (any_friction_)
+    start_ = state.position;
+}
+
+bool SelfContacts::candidatesHold(const NodeArray& x) const
+{
+  if (found_at_.cols() != x.cols())
+    return false;
+  // Two links come closer by at most |d_i - c| + |d_j - c| for their nodes' displacements d_i, d_j since
+  // the candidates were found and any common c, since moving everything by c changes no distance. With c
+  // the mean displacement, a body that falls or is carried as a whole keeps its list.
+  Vec3 mean = Vec3::Zero();
+  for (const int node : nodes_)
+    mean += x.col(node) - found_at_.col(node);
+  mean /= static_cast<double>(nodes_.size());
+  const double limit = 0.25 * skin_ * skin_;
+  for (const int node : nodes_)
+    if ((x.col(node) - found_at_.col(node) - mean).squaredNorm() > limit)
+      return false;
+  return true;
+}
+
+void SelfContacts::findCandidates(const NodeArray& x)
+{
+  double longest = 0.0;
+  for (std::size_t s = 0; s < segments_.size(); ++s)
+  {
+    const auto [a, b] = segments_[s];
+    middle_.col(static_cast<Eigen::Index>(s)) = 0.5 * (x.col(a) + x.col(b));
+    half_[s] = 0.5 * (x.col(a) - x.col(b)).norm();
+    longest = std::max(longest, 2.0 * half_[s]);
+  }
+  // A candidate pair's links come within twice their radii and the skin (see below), so their midpoints
+  // within the longest link and that: the cells' width.
+  grid_.build(x, segments_, longest + 4.0 * largest_radius_ + skin_ + 1e-9);
+  candidates_.clear();
+  grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    if (a == c || a == d || b == c || b == d)
+      return;
+    if (body_[s] == body_[t])
+    {
+      // Neighbours along one rope touch at their joints; a jelly's springs cross each other at rest (a
+      // cell's diagonals) and only its nodes stay out of them; a cloth's (or jelly's) nodes within twice
+      // their contact distance at rest (its direct and diagonal neighbours) are held apart by its springs,
+      // and come that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute
+      // Physics).
+      const bool ball_s = a == b, ball_t = c == d;
+      if (!ball_s && !ball_t)
+      {
+        if (springs_collide_[static_cast<std::size_t>(body_[s])] || std::abs(a - c) <= kSkippedLinks)
+          return;
+      }
+      else if (ball_s && ball_t &&
+               (rest_.col(static_cast<Eigen::Index>(s)) - rest_.col(static_cast<Eigen::Index>(t))).norm() <
+                   2.0 * (radius_[s] + radius_[t]))
+      {
+        return;
+      }
+    }
+    const double within = 2.0 * (radius_[s] + radius_[t]) + skin_;
+    // Bounding balls first: most pairs in neighbouring cells are farther apart than that.
+    const double bound = half_[s] + half_[t] + within;
+    if ((middle_.col(static_cast<Eigen::Index>(s)) - middle_.col(static_cast<Eigen::Index>(t))).squaredNorm() >
+        bound * bound)
+      return;
+    double p, q;
+    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < within)
+      candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
+  });
+  found_at_ = x;
+  ++searches_;
+}
+
+bool SelfContacts::resolve(const Model& model, State& state)
+{
+  if (segments_.empty())
+    return false;
+  NodeArray& x = state.position;
+  NodeArray& v = state.velocity;
+  if (!candidatesHold(x))
+    findCandidates(x);
+  // The pairs that touch, or nearly (within their radii again, as the passes move them).
+  near_.clear();
+  for (const auto& [s, t] : candidates_)
+  {
+    double p, q;
+    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
+      near_.push_back({ s, t, 0.0, 0.0 });
+  }
+  bool touched = false;
+  const Eigen::VectorXd& w = model.inverse_mass;
+  // The contact of pair k at the current positions: the nearest points' parameters, the unit normal from
+  // t's link to s's, the distance and each node's share; false if there is no direction or no free node.
+  struct Contact
+  {
+    double p, q, distance, ka, kb, kc, kd, weight;
+    Vec3 n;
+  };
+  const auto contact = [&](std::size_t s, std::size_t t, Contact& k) {
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    const Vec3 between = contactGap(x, segments_[s], segments_[t], k.p, k.q);
+    k.distance = between.norm();
+    if (!(k.distance > 1e-12))
+      return false;  // crossing exactly: no direction to part them in (the next sub-step has one)
+    k.n = between / k.distance;
+    k.ka = (1.0 - k.p) * w[a];
+    k.kb = k.p * w[b];
+    k.kc = (1.0 - k.q) * w[c];
+    k.kd = k.q * w[d];
+    k.weight = (1.0 - k.p) * k.ka + k.p * k.kb + (1.0 - k.q) * k.kc + k.q * k.kd;
+    return k.weight > 0.0;
+  };
+  // Changes y (positions or velocities) of the four nodes so that the difference between the two nearest
+  // points changes by `change`, each node by its share of the inverse mass there.
+  const auto part = [&](std::size_t s, std::size_t t, const Contact& k, NodeArray& y, const Vec3& change) {
+    const Vec3 unit = change / k.weight;
+    y.col(segments_[s].first) += k.ka * unit;
+    y.col(segments_[s].second) += k.kb * unit;
+    y.col(segments_[t].first) -= k.kc * unit;
+    y.col(segments_[t].second) -= k.kd * unit;
+  };
+  // The difference of y (positions or velocities) between the two nearest points.
+  const auto between = [&](std::size_t s, std::size_t t, const Contact& k, const NodeArray& y) {
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    return Vec3((1.0 - k.p) * y.col(a) + k.p * y.col(b) - (1.0 - k.q) * y.col(c) - k.q * y.col(d));
+  };
+  // Projected Gauss-Seidel on each pair's accumulated push and speed change (Catto's accumulated
+  // impulses): a pass may take back part of what an earlier one gave, never more. A push at a point
+  // inside a link moves its nearer node by more than the depth there; without taking back, a neighbouring
+  // pair's push on that node would leave it thrown off the surface (and in a groove, off with no friction
+  // holding it).
+  Contact k;
+  for (int pass = 0; pass < kPasses; ++pass)
+    for (NearPair& pair : near_)
+    {
+      if (!contact(pair.s, pair.t, k))
+        continue;
+      const double push = std::max(-pair.push, radius_[pair.s] + radius_[pair.t] - k.distance);
+      // Only links that touch stop approaching; others give back what they took.
+      const double stop = pair.push + push > 0.0 ? std::max(-pair.stop, -between(pair.s, pair.t, k, v).dot(k.n))
+                                                 : -pair.stop;
+      if (push != 0.0)
+        part(pair.s, pair.t, k, x, push * k.n);
+      if (stop != 0.0)
+        part(pair.s, pair.t, k, v, stop * k.n);
+      pair.push += push;
+      pair.stop += stop;
+      touched = touched || pair.push > 0.0;
+    }
+  if (!any_friction_ || !touched)
+    return touched;
+  // Coulomb friction as on a collider (contact_response.h), relative to the other link, once the links
+  // are apart: the sub-step's tangential slip of the nearest points cancelled up to friction * the push
+  // apart, their tangential speed reduced by up to friction * the approach speed removed. After the
+  // normal passes, not in them: in a groove, a link's motion into the other side is tangential at the
+  // first side's contact, and friction there would spend its budget against what the other side stops.
+  for (int pass = 0; pass < kPasses; ++pass)
+    for (NearPair& pair : near_)
+    {
+      const double friction = 0.5 * (friction_[pair.s] + friction_[pair.t]);
+      if (!(friction > 0.0) || !(pair.push > 0.0 || pair.stop > 0.0) || !contact(pair.s, pair.t, k))
+        continue;
+      // Cancels the tangential part of `relative` (a motion of y at the contact) up to friction * budget.
+      const auto resist = [&](const Vec3& relative, double& budget, NodeArray& y) {
+        const Vec3 tangential = relative - relative.dot(k.n) * k.n;
+        const double length = tangential.norm();
+        if (!(length > 0.0))
+          return;
+        const double taken = std::min(length, friction * budget);
+        part(pair.s, pair.t, k, y, -(taken / length) * tangential);
+        budget -= taken / friction;
+      };
+      resist(between(pair.s, pair.t, k, x) - between(pair.s, pair.t, k, start_), pair.push, x);
+      resist(between(pair.s, pair.t, k, v), pair.stop, v);
+    }
+  return touched;
+}
+
+}  // namespace soft_body_sim

@@ -1,0 +1,87 @@
+#include "core/integrators/implicit_euler/collider_holds.h"
+
+#include <algorithm>
+
+#include "core/integrators/implicit_euler/hold_friction.h"
+
+namespace soft_body_sim
+{
+void ColliderHolds::analyze(const Model& model)
+{
+  solid_node_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
+  hold_force_.assign(static_cast<std::size_t>(model.nodeCount()), 0.0);
+  holds_.clear();
+  holds_.reserve(static_cast<std::size_t>(model.nodeCount()));
+  for (const Tetrahedron& tet : model.tetrahedra)
+    for (const int node : tet.nodes)
+      solid_node_[static_cast<std::size_t>(node)] = 1;
+}
+
+void ColliderHolds::assemble(const NewtonPoint& point, const ContactQuery& contacts, bool first_iteration,
+                             BlockSystem& system)
+{
+  if (first_iteration)
+    find(point, contacts);
+  const double h = point.h;
+  NodeArray& rhs = system.rhs();
+  for (Hold& c : holds_)
+  {
+    const int i = c.node;
+    const Vec3 n = c.contact.normal;
+    // The same surface, planar about where it was found, at this iteration's predicted position.
+    c.depth = c.found_depth - n.dot(point.x.col(i) + point.offset.col(i) - c.found_at);
+    Eigen::Matrix3d& d = system.diagonal(i);
+    const double block = d.trace() / 3.0;  // b [kg]
+    c.scaled = kContactStiffness * block;  // h^2 k
+    rhs.col(i) += (c.scaled / h * c.depth) * n;
+    d += c.scaled * (n * n.transpose());
+    // A hold that pulled in the last step (< 0) adds nothing: only the approach's force presses then.
+    const double normal_force = std::max(block * c.depth / (h * h), hold_force_[static_cast<std::size_t>(i)]);
+    Vec3 tangential;
+    const double damping =
+        frictionDamping(c.contact.friction, normal_force, point.v.col(i) - c.contact.velocity, n, tangential);
+    if (!(damping > 0.0))
+      continue;
+    rhs.col(i) -= h * damping * tangential;
+    d += h * damping * (Eigen::Matrix3d::Identity() - n * n.transpose());
+  }
+}
+
+void ColliderHolds::find(const NewtonPoint& point, const ContactQuery& contacts)
+{
+  const Model& model = point.model;
+  NodeContact contact;
+  holds_.clear();
+  const double margin = model.gravity.norm() * point.h * point.h;
+  for (int i = 0; i < model.nodeCount(); ++i)
+  {
+    if (!solid_node_[static_cast<std::size_t>(i)] || !model.isFree(i))
+      continue;
+    const Vec3 predicted = point.x.col(i) + point.offset.col(i);
+    if (!contacts.touching(model, i, predicted, margin, contact))
+      continue;
+    const double depth = contact.depth + point.h * contact.velocity.dot(contact.normal);
+    if (depth > (hold_force_[static_cast<std::size_t>(i)] < 0.0 ? 0.0 : -margin))
+      holds_.push_back({ i, contact, predicted, depth, depth, 0.0 });
+  }
+}
+
+double ColliderHolds::force(const Hold& hold, double h, const NodeArray& dv)
+{
+  return hold.scaled / (h * h) * (hold.depth - h * hold.contact.normal.dot(dv.col(hold.node)));
+}
+
+void ColliderHolds::letGoPulling(double h, const NodeArray& dv)
+{
+  holds_.erase(std::remove_if(holds_.begin(), holds_.end(), [&](const Hold& c) { return force(c, h, dv) < 0.0; }),
+               holds_.end());
+}
+
+void ColliderHolds::noteForces(double h, const NodeArray& dv)
+{
+  std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
+  for (const Hold& c : holds_)
+    hold_force_[static_cast<std::size_t>(c.node)] = force(c, h, dv);
+}
+
+}  // namespace soft_body_sim

@@ -1,0 +1,200 @@
+#include <tuple>
+#include <utility>
+
+#include "core/elements/element_kinds.h"
+#include "core/integrators/implicit_euler/collider_holds.h"
+#include "core/integrators/implicit_euler/newton_system.h"
+#include "core/integrators/implicit_euler/surface_holds.h"
+#include "core/integrators/integrator_kit.h"
+#include "soft_body_sim/core/elements/rods.h"
+
+namespace soft_body_sim
+{
+namespace
+{
+/// Every element kind's ImplicitBlocks (element_kinds.h), in the registry's order.
+template <class List>
+struct ImplicitBlocksOf;
+template <class... Kinds>
+struct ImplicitBlocksOf<KindList<Kinds...>>
+{
+  using type = std::tuple<typename Kinds::ImplicitBlocks...>;
+};
+using KindBlocks = ImplicitBlocksOf<ElementKinds>::type;
+
+template <class Tuple, class F>
+void forEachOf(Tuple& tuple, F&& f)
+{
+  std::apply([&](auto&... blocks) { (f(blocks), ...); }, tuple);
+}
+
+/// Backward Euler, v_{n+1} = v_n + h M^-1 f(x_n + h v_{n+1}, v_{n+1}), x_{n+1} = x_n + h v_{n+1},
+/// solved by Newton's method as in Baraff & Witkin 1998 ("Large steps in cloth simulation"):
+/// each iteration linearises f about (x_lin, v_k) and solves
+///   (M - h D - h^2 K) dv = h f(x_lin, v_k) + h K (x_n + h v_k - x_lin) - M (v_k - v_n)
+/// with K = df/dx, D = df/dv (BlockSystem: directly, block tridiagonally on chains or by a sparse LDL^T, or
+/// by preconditioned conjugate gradients, whichever costs less). The first iteration linearises at
+/// x_lin = x_n (exactly Baraff & Witkin's step); later ones at x_lin = x_n + h v_k. Every element kind adds
+/// its forces and blocks (newton_system.h; springs, gas cells, rods and tetrahedra each say how they keep
+/// A symmetric positive definite), the damping force's dependence on x neglected, as in Baraff & Witkin;
+/// distance constraints are projected after the solve (the constraint pass). Unconditionally stable on a
+/// linear spring; first order.
+/// The matrix's pattern (which node pairs couple) depends only on the elements and which nodes are
+/// pinned: it is analysed on the first step and after every model change, and each Newton iteration only
+/// writes its values and factorises. Every array is sized once: a step allocates nothing after the first.
+/// Contact on soft solids happens inside the same solve: a solid's nodes are held on the colliders
+/// (collider_holds.h), other bodies' nodes on a solid's surface (surface_holds.h).
+class ImplicitEuler final : public ForceBasedIntegrator
+{
+public:
+  explicit ImplicitEuler(LinearSolve linear_solve) : system_(linear_solve) {}
+
+  void modelChanged() override { analyzed_ = false; }
+
+  /// Solids (nodes of tetrahedra) feel the colliders inside the solve (collider_holds.h).
+  void stepWithContacts(const Model& model, State& state, double h, int iterations, const ContactQuery* contacts) override
+  {
+    contacts_ = model.tetrahedra.empty() ? nullptr : contacts;
+    step(model, state, h, iterations);
+    contacts_ = nullptr;
+  }
+
+  void step(const Model& model, State& state, double h, int iterations) override
+  {
+    const int n = model.nodeCount();
+    start_x_ = state.position;
+    start_v_ = state.velocity;
+    if (!analyzed_)
+      analyze(model);
+    for (int k = 0; k < iterations; ++k)
+    {
+      const NodeArray& v_k = state.velocity;
+      // x_lin and the offset x_n + h v_k - x_lin at which K acts: x_lin = x_n on the first iteration (the
+      // offset h v_k), x_n + h v_k on the others (no offset).
+      offset_.setZero(3, n);
+      if (k > 0)
+        linear_x_ = start_x_;
+      for (int i = 0; i < n; ++i)
+      {
+        if (!model.isFree(i))
+          continue;
+        if (k == 0)
+          offset_.col(i) = h * v_k.col(i);
+        else
+          linear_x_.col(i) += h * v_k.col(i);
+      }
+      assemble(NewtonPoint{ model, k == 0 ? start_x_ : linear_x_, v_k, state.twist, offset_, h }, k == 0);
+      solve(model);
+      for (int i = 0; i < n; ++i)
+        if (model.isFree(i))
+          state.velocity.col(i) += delta_v_.col(i);
+      if (k + 1 < iterations)
+      {
+        if (contacts_ != nullptr)
+          collider_holds_.letGoPulling(h, delta_v_);
+        surface_holds_.letGoPulling(h, delta_v_);
+      }
+    }
+    if (contacts_ != nullptr)
+      collider_holds_.noteForces(h, delta_v_);
+    surface_holds_.noteForces(h, delta_v_);
+    for (int i = 0; i < n; ++i)
+      if (model.isFree(i))
+        state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
+    constraints_.apply(model, state, h, iterations);
+    for (const Rod& rod : model.rods)
+      updateRodTwists(rod, state.position, state.twist);
+  }
+
+private:
+  /// The pattern: every element kind's node pairs, then the surface holds' (which join as they appear).
+  void analyze(const Model& model)
+  {
+    system_.clearPattern();
+    forEachOf(kinds_, [&](auto& blocks) { blocks.analyze(model, system_); });
+    collider_holds_.analyze(model);
+    surface_holds_.analyze(model, system_);
+    // A surface hold couples a node to a triangle of another body, which a chain's pattern has no place
+    // for: where holds can arise, the sparse pattern is prepared too, for the steps that have any.
+    system_.analyze(model.nodeCount(), surface_holds_.present());
+    analyzed_ = true;
+  }
+
+  /// A = M - h D - h^2 K and rhs (see the class comment) at `point`: the masses' blocks and the external
+  /// forces here, then every element kind's and every hold's.
+  void assemble(const NewtonPoint& point, bool first_iteration)
+  {
+    const Model& model = point.model;
+    const double h = point.h;
+    system_.start(model.nodeCount());
+    NodeArray& rhs = system_.rhs();
+    for (int i = 0; i < model.nodeCount(); ++i)
+    {
+      Eigen::Matrix3d& d = system_.diagonal(i);
+      if (!model.isFree(i))
+      {
+        // Pinned: dv = 0, an identity row.
+        rhs.col(i).setZero();
+        d.setIdentity();
+        continue;
+      }
+      const double m = model.mass[i];
+      const Vec3 f = m * model.gravity - m * model.drag * point.v.col(i);
+      rhs.col(i) = h * f - m * (point.v.col(i) - start_v_.col(i));
+      d = (m * (1.0 + h * model.drag)) * Eigen::Matrix3d::Identity();
+    }
+    forEachOf(kinds_, [&](auto& blocks) { blocks.assemble(point, system_); });
+    if (contacts_ != nullptr)
+      collider_holds_.assemble(point, *contacts_, first_iteration, system_);
+    surface_holds_.assemble(point, first_iteration, system_);
+  }
+
+  /// The blocks that the element kinds and the surface holds keep, as BlockSystem::solve asks for them.
+  struct Blocks
+  {
+    const Model& model;
+    const KindBlocks& kinds;
+    const SurfaceHolds& holds;
+
+    void multiply(const NodeArray& p, NodeArray& out) const
+    {
+      std::apply([&](const auto&... blocks) { (blocks.multiply(model, p, out), ...); }, kinds);
+      holds.multiply(model, p, out);
+    }
+    void addToPreconditioner(std::vector<Eigen::Matrix3d>& diagonal) const
+    {
+      std::apply([&](const auto&... blocks) { (blocks.addToPreconditioner(model, diagonal), ...); }, kinds);
+      holds.addToPreconditioner(model, diagonal);
+    }
+    template <class Solver>
+    void write(Solver& solver) const
+    {
+      std::apply([&](const auto&... blocks) { (blocks.write(model, solver), ...); }, kinds);
+      holds.write(model, solver);
+    }
+  };
+
+  /// delta_v_ = A^-1 rhs; the block-tridiagonal solve serves the steps without surface holds.
+  void solve(const Model& model)
+  {
+    if (!surface_holds_.empty() && !system_.iterativeOnly())
+      surface_holds_.placePairs(system_);
+    system_.solve(Blocks{ model, kinds_, surface_holds_ }, surface_holds_.empty(), delta_v_);
+  }
+
+  BlockSystem system_;
+  KindBlocks kinds_;
+  ColliderHolds collider_holds_;
+  SurfaceHolds surface_holds_;
+  bool analyzed_ = false;  ///< the system holds the pattern of the current model
+  NodeArray start_x_, start_v_, linear_x_, offset_;
+  NodeArray delta_v_;
+  const ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
+};
+}  // namespace
+
+std::unique_ptr<Integrator> makeImplicitEuler() { return makeImplicitEuler(LinearSolve::Cheaper); }
+
+std::unique_ptr<Integrator> makeImplicitEuler(LinearSolve solve) { return std::make_unique<ImplicitEuler>(solve); }
+
+}  // namespace soft_body_sim

@@ -1,0 +1,104 @@
+// Other bodies' nodes held on a soft solid's surface inside implicit Euler's solve (private to the core
+// library).
+//
+// As a solid's node is held on a collider (collider_holds.h), a node p of another body (a rope's, a
+// cloth's, another solid's) whose predicted position lies within its contact radius of a solid's boundary
+// triangle, or behind it (SurfaceContacts::find), or, if its hold pushed in the last step, within
+// max(|g| h^2, r_p / 2) of that, is held by a one-sided spring on the gap g = n . (x_p - q) - r_p,
+// q = sum_k w_k x_k the triangle's nearest point at weights w: the Jacobian of g is weights_l n^T on the four
+// nodes, so the node and the triangle's nodes push each other apart with equal and opposite forces (momentum
+// kept) and A gains h^2 k weights_l weights_m n n^T. k is kContactStiffness times the contact's effective
+// mass b = 1 / sum_l weights_l^2 / b_l (b_l the free nodes' diagonal means): the solve leaves about
+// 1 / kContactStiffness of the depth. Coulomb friction damps their relative velocity across n as on a
+// collider, pressed by max(b d / h^2, the hold's force in the last step), the solid's `friction` (two
+// solids': the mean). A hold couples a node to a triangle of another body: those node pairs join the
+// pattern when they first appear (placePairs).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <unordered_map>
+#include <vector>
+
+#include "core/contact/surface_contacts.h"
+#include "core/integrators/implicit_euler/newton_system.h"
+
+namespace soft_body_sim
+{
+class SurfaceHolds
+{
+public:
+  /// Prepares for `model` if it has a solid with a surface and something that could touch it (else
+  /// present() is false and every step has no holds). Call after every element kind has placed its pairs in
+  /// `system`: the holds' pairs come after them.
+  void analyze(const Model& model, const BlockSystem& system);
+  /// Whether the model can have surface holds at all.
+  bool present() const { return contacts_.has_value(); }
+  /// Whether the Newton iteration being assembled has any.
+  bool empty() const { return holds_.empty(); }
+
+  /// Finds the holds at the step's first Newton iteration and keeps them through the others; adds their
+  /// push and friction to rhs (their blocks stay here: multiply, addToPreconditioner, write).
+  void assemble(const NewtonPoint& point, bool first_iteration, BlockSystem& system);
+  /// Gives every node pair of every hold (the node with the triangle's three, and those among themselves) a
+  /// slot of the pattern. A pair not yet in it has the sparse pattern analysed again with it, the pairs of
+  /// earlier holds kept unless they are more than kKeptPairs times the present holds' (then only these):
+  /// resting contact keeps its pattern from step to step, sliding contact pays an analysis when it reaches a
+  /// new triangle, and pairs of contacts long gone do not pile up.
+  void placePairs(BlockSystem& system);
+
+  void multiply(const Model& model, const NodeArray& p, NodeArray& out) const;
+  void addToPreconditioner(const Model& model, std::vector<Eigen::Matrix3d>& diagonal) const;
+  template <class Solver>
+  void write(const Model&, Solver& solver) const
+  {
+    // A hold's blocks weights_l weights_m B (only ever in the sparse pattern: the block-tridiagonal solve
+    // serves only steps without holds).
+    for (std::size_t k = 0; k < holds_.size(); ++k)
+    {
+      const Hold& c = holds_[k];
+      for (int l = 0; l < 4; ++l)
+        if (c.nodes[l] >= 0)
+          solver.addDiagonal(c.nodes[l], (c.weights[l] * c.weights[l]) * c.block);
+      for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
+        if (slots_[kFourNodePairs.size() * k + p] >= 0)
+          solver.addOffDiagonal(static_cast<std::size_t>(slots_[kFourNodePairs.size() * k + p]),
+                                (c.weights[kFourNodePairs[p].first] * c.weights[kFourNodePairs[p].second]) * c.block);
+    }
+  }
+
+  /// As ColliderHolds::letGoPulling.
+  void letGoPulling(double h, const NodeArray& dv);
+  /// As ColliderHolds::noteForces.
+  void noteForces(double h, const NodeArray& dv);
+
+private:
+  struct Hold
+  {
+    SurfaceTouch touch;  ///< as found at the step's first Newton iteration (node p, triangle, weights, n)
+    int nodes[4];        ///< p, then the triangle's three nodes, each -1 where pinned
+    double weights[4];   ///< 1, -w_0, -w_1, -w_2: the gap x_p - q = sum_l weights_l x_l
+    double depth;        ///< d [m] at this iteration's predicted positions
+    double scaled;       ///< h^2 k [kg] in this iteration
+    Eigen::Matrix3d block;  ///< B = h^2 k n n^T + h c (I - n n^T); A gains weights_l weights_m B on (l, m)
+  };
+  void find(const NewtonPoint& point);
+  /// k (d - h n . sum_l weights_l dv_l) [N]: the force `hold` took in the Newton iteration that solved dv
+  /// (> 0 pushing).
+  static double force(const Hold& hold, double h, const NodeArray& dv);
+
+  /// How many times the present holds' node pairs the pattern keeps of earlier holds' (placePairs).
+  static constexpr std::size_t kKeptPairs = 4;
+
+  std::optional<SurfaceContacts> contacts_;  ///< the solids' surfaces, if anything can touch them
+  std::vector<SurfaceTouch> touches_;        ///< what it found at a step's first iteration
+  std::vector<Hold> holds_;                  ///< the holds of the last Newton iteration
+  /// per node: [N] the force its hold took in the last step (> 0 pushing, < 0 pulling), 0 without a hold
+  std::vector<double> hold_force_;
+  NodeArray predicted_;                      ///< x + h v where holds are found [m]
+  std::size_t element_pairs_ = 0;            ///< how many of the pattern's pairs are the elements'
+  std::unordered_map<std::uint64_t, std::size_t> slot_of_pair_;  ///< a hold's node pair -> its slot
+  std::vector<int> slots_;                   ///< per hold, six: each node pair's slot, or -1
+};
+
+}  // namespace soft_body_sim

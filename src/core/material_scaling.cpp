@@ -1,0 +1,37 @@
+#include "soft_body_sim/core/material_scaling.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "core/elements/element_kinds.h"
+
+namespace soft_body_sim
+{
+MaterialScaling::MaterialScaling(const Model& built) : scaling_(built.bodies.size()), has_material_(built.bodies.size(), 0)
+{
+  forEachKind([&](auto kind) {
+    kind.of(built_) = kind.of(built);
+    for (const auto& element : kind.of(built))
+      has_material_[built.bodyOf(kind.bodyNode(element))] = 1;
+  });
+}
+
+void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& scaling)
+{
+  // Stiffness and pressure divide (compliance = 1 / k, Boyle's law p0 A0 / A): they must stay > 0.
+  if (!(scaling.stiffness > 0.0 && std::isfinite(scaling.stiffness)) ||
+      !(scaling.pressure > 0.0 && std::isfinite(scaling.pressure)) ||
+      !(scaling.damping >= 0.0 && std::isfinite(scaling.damping)))
+    throw std::invalid_argument("World: body scaling: stiffness and pressure must be finite and > 0, damping >= 0");
+  scaling_.at(body) = scaling;
+  // From the built values, not the current ones: factors do not compound and 1 restores the scene.
+  forEachKind([&](auto kind) {
+    auto& live = kind.of(model);
+    const auto& built = kind.of(built_);
+    for (std::size_t k = 0; k < live.size(); ++k)
+      if (model.bodyOf(kind.bodyNode(built[k])) == body)
+        kind.scale(live[k], built[k], scaling);
+  });
+}
+
+}  // namespace soft_body_sim

@@ -1,0 +1,229 @@
+// A symmetric positive definite linear system of 3x3 blocks, one block row per node: implicit Euler's
+// Newton system A dv = rhs (private to the core library). It owns what every element kind shares: the
+// right-hand side, each node's diagonal block, the pattern of node pairs whose blocks may be non-zero (one
+// slot each), and the solves. The off-diagonal blocks stay with the kinds that make them (each kind's
+// ImplicitBlocks, element_kinds.h), in whatever compact form suits the kind, so A is never stored whole
+// except inside a direct solver. A solve takes them as `Blocks`, anything with
+//   multiply(p, out)            out += (A - its diagonal blocks in diagonal()) p
+//   addToPreconditioner(blocks) each node's block of A not in diagonal() (kinds that keep theirs apart)
+//   write(solver)               addDiagonal / addOffDiagonal of those blocks into a direct solver
+// and chooses between the direct solves (block tridiagonal where the free nodes form chains, else a sparse
+// LDL^T) and preconditioned conjugate gradients by what they cost (see solve).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include <Eigen/LU>
+
+#include "core/integrators/integrator_kit.h"
+#include "core/solvers/block_tridiagonal_solver.h"
+#include "core/solvers/sparse_block_solver.h"
+#include "soft_body_sim/core/model.h"
+
+namespace soft_body_sim
+{
+class BlockSystem
+{
+public:
+  using Matrix3 = Eigen::Matrix3d;
+
+  explicit BlockSystem(LinearSolve mode) : mode_(mode) {}
+
+  // --- the pattern: node pairs whose blocks may be non-zero, one slot each --------------------------
+  /// Forgets every pair (a new model).
+  void clearPattern() { pairs_.clear(); }
+  /// The slot of the new pair (a, b), a != b both free.
+  int addPair(int a, int b)
+  {
+    pairs_.emplace_back(a, b);
+    return static_cast<int>(pairs_.size()) - 1;
+  }
+  std::size_t pairCount() const { return pairs_.size(); }
+  /// Drops the pairs after the first `count` (those a kind added later and no longer needs).
+  void truncatePairs(std::size_t count) { pairs_.resize(count); }
+  /// Prepares the solves for the pattern over `nodes` nodes: the block-tridiagonal one where the pairs form
+  /// chains, the sparse one where the chains alone cannot serve (not chains, or `sparse_too`: pairs outside
+  /// chains may join in some steps, analyzeSparse).
+  void analyze(int nodes, bool sparse_too)
+  {
+    nodes_ = nodes;
+    chains_ = mode_ != LinearSolve::Iterative && chain_solver_.analyze(nodes, pairs_);
+    factorable_ = chains_ && !sparse_too;
+    if (!factorable_)
+      analyzeSparse();
+  }
+  /// Prepares the sparse solve again, for pairs added since analyze.
+  void analyzeSparse()
+  {
+    factorable_ = mode_ != LinearSolve::Iterative &&
+                  sparse_solver_.analyze(nodes_, pairs_, mode_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork);
+  }
+  bool iterativeOnly() const { return mode_ == LinearSolve::Iterative; }
+
+  // --- the values of one Newton iteration -----------------------------------------------------------
+  /// Per node: its diagonal block of A [kg], which the kinds add to (their diagonal blocks, unless they keep
+  /// them apart: addToPreconditioner and write give them then).
+  std::vector<Matrix3>& diagonal() { return diagonal_; }
+  const std::vector<Matrix3>& diagonal() const { return diagonal_; }
+  Matrix3& diagonal(int node) { return diagonal_[static_cast<std::size_t>(node)]; }
+  /// The right-hand side (3 x nodes).
+  NodeArray& rhs() { return rhs_; }
+  /// Sizes the right-hand side and the diagonal for `nodes` nodes and restarts the condition estimate.
+  void start(int nodes)
+  {
+    rhs_.resize(3, nodes);
+    diagonal_.resize(static_cast<std::size_t>(nodes));
+    condition_ = 1.0;
+  }
+  /// An element's estimate of the block-Jacobi preconditioned A's condition number (the largest is kept):
+  /// about 1 + 4 (h^2 k + h c) / m for a spring of stiffness k and dashpot c on its lightest free end m.
+  void noteCondition(double condition) { condition_ = std::max(condition_, condition); }
+
+  /// dv = A^-1 rhs: directly, A written from the diagonal and `blocks` into the analysed pattern (block
+  /// tridiagonal where the free nodes form chains and `chains_usable`, else sparse), or by conjugate
+  /// gradients where they cost less (see kDirectWorkPerRootCondition). A chain's factorisation costs about as
+  /// much as one CG sweep, so a chain always takes the direct path.
+  template <class Blocks>
+  void solve(const Blocks& blocks, bool chains_usable, NodeArray& dv)
+  {
+    if (chains_ && chains_usable)
+    {
+      solveDirectly(blocks, chain_solver_, dv);
+      return;
+    }
+    const bool cheaper_by_cg = mode_ == LinearSolve::Cheaper &&
+                               sparse_solver_.factorWork() / sparse_solver_.matrixEntries() >
+                                   kDirectWorkPerRootCondition * std::sqrt(condition_);
+    if (!factorable_ || cheaper_by_cg)
+    {
+      buildPreconditioner(blocks);
+      solveIteratively(blocks, dv);
+      return;
+    }
+    solveDirectly(blocks, sparse_solver_, dv);
+  }
+
+private:
+  /// Writes A into `solver` (analysed with the pattern's slots), factorises it and solves for dv.
+  template <class Blocks, class Solver>
+  void solveDirectly(const Blocks& blocks, Solver& solver, NodeArray& dv)
+  {
+    solver.start(diagonal_);
+    blocks.write(solver);
+    // A is symmetric positive definite by construction (each kind keeps its blocks so), unless the state is
+    // not finite: then the step is not finite either, and the divergence guard (guard.h) takes it.
+    if (solver.factorize())
+      solver.solve(rhs_, dv);
+    else
+      dv.setConstant(3, rhs_.cols(), std::numeric_limits<double>::quiet_NaN());
+  }
+
+  /// Block Jacobi for conjugate gradients: the inverse of each node's full 3x3 diagonal block (SPD, so
+  /// invertible).
+  template <class Blocks>
+  void buildPreconditioner(const Blocks& blocks)
+  {
+    preconditioner_ = diagonal_;
+    blocks.addToPreconditioner(preconditioner_);
+    for (Matrix3& p : preconditioner_)
+      p = p.inverse().eval();
+  }
+
+  /// out = A p.
+  template <class Blocks>
+  void multiply(const Blocks& blocks, const NodeArray& p, NodeArray& out) const
+  {
+    for (Eigen::Index i = 0; i < p.cols(); ++i)
+      out.col(i) = diagonal_[static_cast<std::size_t>(i)] * p.col(i);
+    blocks.multiply(p, out);
+  }
+
+  void precondition(const NodeArray& r, NodeArray& z) const
+  {
+    for (Eigen::Index i = 0; i < r.cols(); ++i)
+      z.col(i) = preconditioner_[static_cast<std::size_t>(i)] * r.col(i);
+  }
+
+  static double dot(const NodeArray& a, const NodeArray& b) { return a.cwiseProduct(b).sum(); }
+
+  /// dv = A^-1 rhs by preconditioned conjugate gradients from 0, stopped at a relative residual of
+  /// kTolerance or after 2 * 3n iterations (the algorithm and the stopping rule of Eigen's
+  /// ConjugateGradient), multiplying by the blocks directly, preconditioned by the inverse of each node's
+  /// 3x3 diagonal block.
+  template <class Blocks>
+  void solveIteratively(const Blocks& blocks, NodeArray& dv)
+  {
+    const Eigen::Index n = rhs_.cols();
+    dv.setZero(3, n);
+    residual_ = rhs_;
+    const double rhs_norm2 = rhs_.squaredNorm();
+    if (rhs_norm2 == 0.0)
+      return;
+    const double threshold = std::max(kTolerance * kTolerance * rhs_norm2, std::numeric_limits<double>::min());
+    double residual_norm2 = rhs_norm2;
+    if (residual_norm2 < threshold)
+      return;  // rhs so small (near underflow) that any iteration would divide by zero
+    direction_.resize(3, n);
+    z_.resize(3, n);
+    product_.resize(3, n);
+    precondition(residual_, direction_);
+    double r_dot_z = dot(residual_, direction_);
+    const Eigen::Index max_iterations = 2 * 3 * n;
+    for (Eigen::Index iteration = 0; iteration < max_iterations; ++iteration)
+    {
+      multiply(blocks, direction_, product_);
+      const double alpha = r_dot_z / dot(direction_, product_);
+      dv += alpha * direction_;
+      residual_ -= alpha * product_;
+      residual_norm2 = residual_.squaredNorm();
+      if (residual_norm2 < threshold)
+        break;
+      precondition(residual_, z_);
+      const double previous_r_dot_z = r_dot_z;
+      r_dot_z = dot(residual_, z_);
+      direction_ = z_ + (r_dot_z / previous_r_dot_z) * direction_;
+    }
+  }
+
+  /// CG stops at a relative residual of 1e-12: far below the scheme's O(h) error; without it CG would
+  /// iterate to machine precision (up to 6n sweeps).
+  static constexpr double kTolerance = 1e-12;
+
+  /// Which solve is cheaper. A conjugate-gradient sweep costs one multiply-add per entry of A, and CG's
+  /// sweeps to a relative residual of 1e-12 grow like the square root of the preconditioned condition
+  /// number (noteCondition); a factorisation costs its work per entry. So the direct path is taken while
+  /// work per entry <= C sqrt(condition). The bound ln(2e12) / 2 = 14 sweeps per square root of the
+  /// condition would give C = 14, but CG converges faster than its bound on these spectra and a sparse
+  /// factorisation's multiply-add costs more than a sweep's: measured on the benchmark cloth at
+  /// dt = 1/60 s (bench_step BM_ClothLinearSolveAt60Hz, condition ~840), direct is 1.4 times faster at
+  /// 100 nodes (61 per entry, 2.1 sqrt(condition)) and CG 1.1 times faster at 324 (169 per entry,
+  /// 5.8 sqrt(condition)), 1.8 times at 1,024: C = 4 switches between them. On a rope with bending
+  /// springs the factor has no fill (2.9 per entry) and a stiff rope is badly conditioned (k = 1e6 N/m,
+  /// 1 g nodes, dt = 1/60 s: ~1e6): always direct, and linear in the length. At small steps the mass
+  /// dominates the matrix (condition ~1) and CG serves every cloth.
+  static constexpr double kDirectWorkPerRootCondition = 4.0;
+  /// No factorisation is even prepared beyond this work per entry (a 100,000-node cloth would need
+  /// 0.75 GB for its factor).
+  static constexpr double kMaxFactorWork = 2000.0;
+  static constexpr double kAnyWork = std::numeric_limits<double>::infinity();
+
+  const LinearSolve mode_;
+  int nodes_ = 0;
+  std::vector<std::pair<int, int>> pairs_;  ///< the pattern: slot k couples pairs_[k]
+  bool chains_ = false;                     ///< the pairs form chains: chain_solver_ can solve
+  bool factorable_ = true;                  ///< the pattern is prepared for a direct solve (see kMaxFactorWork)
+  double condition_ = 1.0;                  ///< estimate of block-Jacobi preconditioned A's condition number
+  NodeArray rhs_;
+  std::vector<Matrix3> diagonal_;        ///< per node: its block of A (but the kinds' kept apart)
+  std::vector<Matrix3> preconditioner_;  ///< per node: the inverse of A's full diagonal block (CG)
+  NodeArray residual_, direction_, z_, product_;  ///< conjugate gradients' vectors
+  SparseBlockSolver sparse_solver_;
+  BlockTridiagonalSolver chain_solver_;
+};
+
+}  // namespace soft_body_sim
