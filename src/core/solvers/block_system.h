@@ -52,7 +52,7 @@ public:
   void analyze(int nodes, bool sparse_too)
   {
     nodes_ = nodes;
-    chains_ = mode_ != LinearSolve::Iterative && chain_solver_.analyze(nodes, pairs_);
+    chains_ = mode_ != LinearSolve::Iterative && tridiagonal_solver_.analyze(nodes, pairs_);
     factorable_ = chains_ && !sparse_too;
     if (!factorable_)
       analyzeSparse();
@@ -93,7 +93,7 @@ public:
   {
     if (chains_ && chains_usable)
     {
-      solveDirectly(blocks, chain_solver_, dv);
+      solveDirectly(blocks, tridiagonal_solver_, dv);
       return;
     }
     const bool cheaper_by_cg = mode_ == LinearSolve::Cheaper &&
@@ -215,7 +215,7 @@ private:
   const LinearSolve mode_;
   int nodes_ = 0;
   std::vector<std::pair<int, int>> pairs_;  ///< the pattern: slot k couples pairs_[k]
-  bool chains_ = false;                     ///< the pairs form chains: chain_solver_ can solve
+  bool chains_ = false;                     ///< the pairs form chains: tridiagonal_solver_ can solve
   bool factorable_ = true;                  ///< the pattern is prepared for a direct solve (see kMaxFactorWork)
   double condition_ = 1.0;                  ///< estimate of block-Jacobi preconditioned A's condition number
   NodeArray rhs_;
@@ -223,7 +223,7 @@ private:
   std::vector<Matrix3> preconditioner_;  ///< per node: the inverse of A's full diagonal block (CG)
   NodeArray residual_, direction_, z_, product_;  ///< conjugate gradients' vectors
   SparseBlockSolver sparse_solver_;
-  BlockTridiagonalSolver chain_solver_;
+  BlockTridiagonalSolver tridiagonal_solver_;
 };
 
 }  // namespace soft_body_sim
