@@ -56,18 +56,21 @@ IntegratorType readIntegrator(const Context& ctx, const Field& field)
   return type;
 }
 
+GuardPolicy readGuardPolicy(const Context& ctx, const Field& field)
+{
+  const std::string name = readNonEmptyString(ctx, field);
+  GuardPolicy policy{};
+  if (!guardPolicyFromName(name, policy))
+    ctx.fail(field, "unknown policy " + quoted(name) + "; valid policies: " + join(guardPolicyNames()));
+  return policy;
+}
+
 GuardSettings readGuard(const Context& ctx, const Field& field)
 {
   requireMap(ctx, field, kGuardKeys);
   GuardSettings guard;
-  if (const std::optional<Field> value = optionalKey(field, "policy"))
-  {
-    const std::string name = readNonEmptyString(ctx, *value);
-    if (!guardPolicyFromName(name, guard.policy))
-      ctx.fail(*value, "unknown policy " + quoted(name) + "; valid policies: " + join(guardPolicyNames()));
-  }
-  if (const std::optional<Field> value = optionalKey(field, "max_speed"))
-    guard.max_speed = readPositive(ctx, *value);
+  readOptional(ctx, field, "policy", guard.policy, readGuardPolicy);
+  readOptional(ctx, field, "max_speed", guard.max_speed, readPositive);
   return guard;
 }
 
@@ -75,8 +78,7 @@ PhysicsDef readPhysics(const Context& ctx, const Field& field)
 {
   requireMap(ctx, field, kPhysicsKeys);
   PhysicsDef physics;
-  if (const std::optional<Field> value = optionalKey(field, "integrator"))
-    physics.integrator = readIntegrator(ctx, *value);
+  readOptional(ctx, field, "integrator", physics.integrator, readIntegrator);
   if (const std::optional<Field> value = optionalKey(field, "dt"))
   {
     // `auto`: the world picks a stable step from the scene's stiffest spring (chooseStableStep).
@@ -85,16 +87,11 @@ PhysicsDef readPhysics(const Context& ctx, const Field& field)
     else
       physics.step.dt = readPositive(ctx, *value);
   }
-  if (const std::optional<Field> value = optionalKey(field, "substeps"))
-    physics.step.substeps = readAtLeastOne(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "iterations"))
-    physics.step.iterations = readAtLeastOne(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "gravity"))
-    physics.gravity = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "drag"))
-    physics.drag = readNonNegative(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "guard"))
-    physics.guard = readGuard(ctx, *value);
+  readOptional(ctx, field, "substeps", physics.step.substeps, readAtLeastOne);
+  readOptional(ctx, field, "iterations", physics.step.iterations, readAtLeastOne);
+  readOptional(ctx, field, "gravity", physics.gravity, readVec3);
+  readOptional(ctx, field, "drag", physics.drag, readNonNegative);
+  readOptional(ctx, field, "guard", physics.guard, readGuard);
   return physics;
 }
 
@@ -107,11 +104,17 @@ Plane readPlane(const Context& ctx, const Field& field)
   plane.normal = readVec3(ctx, normal);
   if (!(plane.normal.norm() > 1e-12))
     ctx.fail(normal, "must not be the zero vector");
-  if (const std::optional<Field> value = optionalKey(field, "restitution"))
-    plane.restitution = readFraction(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "friction"))
-    plane.friction = readNonNegative(ctx, *value);
+  readOptional(ctx, field, "restitution", plane.restitution, readFraction);
+  readOptional(ctx, field, "friction", plane.friction, readNonNegative);
   return plane;
+}
+
+/// A quaternion written [x, y, z, w], as given (checkCollider rejects a zero one).
+Eigen::Quaterniond readOrientation(const Context& ctx, const Field& field)
+{
+  const std::vector<Field> q = requireListOfSize(ctx, field, 4, "numbers (a quaternion x, y, z, w)");
+  return Eigen::Quaterniond(readNumber(ctx, q[3]), readNumber(ctx, q[0]), readNumber(ctx, q[1]),
+                            readNumber(ctx, q[2]));
 }
 
 /// The keys every collider shape has: name, pose, motion and surface (checked by checkCollider).
@@ -119,30 +122,18 @@ ColliderPlacement readPlacement(const Context& ctx, const Field& field)
 {
   ColliderPlacement at;
   at.name = readNonEmptyString(ctx, requiredKey(ctx, field, "name"));
-  if (const std::optional<Field> value = optionalKey(field, "position"))
-    at.position = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "orientation"))
-  {
-    const std::vector<Field> q = requireListOfSize(ctx, *value, 4, "numbers (a quaternion x, y, z, w)");
-    at.orientation = Eigen::Quaterniond(readNumber(ctx, q[3]), readNumber(ctx, q[0]), readNumber(ctx, q[1]),
-                                        readNumber(ctx, q[2]));
-  }
-  if (const std::optional<Field> value = optionalKey(field, "velocity"))
-    at.velocity = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "angular_velocity"))
-    at.angular_velocity = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "friction"))
-    at.friction = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "restitution"))
-    at.restitution = readNumber(ctx, *value);
-  if (const std::optional<Field> frame = optionalKey(field, "frame"))
-  {
-    at.frame = readFrameId(ctx, *frame);
+  readOptional(ctx, field, "position", at.position, readVec3);
+  readOptional(ctx, field, "orientation", at.orientation, readOrientation);
+  readOptional(ctx, field, "velocity", at.velocity, readVec3);
+  readOptional(ctx, field, "angular_velocity", at.angular_velocity, readVec3);
+  readOptional(ctx, field, "friction", at.friction, readNumber);
+  readOptional(ctx, field, "restitution", at.restitution, readNumber);
+  readOptional(ctx, field, "frame", at.frame, readFrameId);
+  if (!at.frame.empty())  // readFrameId takes no empty id
     for (const char* key : { "velocity", "angular_velocity" })
       if (const std::optional<Field> motion = optionalKey(field, key))
         ctx.fail(*motion, "a collider on a tf frame moves with its frame; " + std::string(key) +
                               " is for colliders without one");
-  }
   return at;
 }
 
@@ -188,10 +179,8 @@ Mesh readMesh(const Context& ctx, const Field& field)
   mesh.at = readPlacement(ctx, field);
   const Field uri = requiredKey(ctx, field, "mesh");
   mesh.uri = readNonEmptyString(ctx, uri);
-  if (const std::optional<Field> value = optionalKey(field, "scale"))
-    mesh.scale = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "voxel_size"))
-    mesh.voxel_size = readPositive(ctx, *value);
+  readOptional(ctx, field, "scale", mesh.scale, readVec3);
+  readOptional(ctx, field, "voxel_size", mesh.voxel_size, readPositive);
   if (!(mesh.scale.minCoeff() > 0.0))
     return mesh;  // checkCollider says so at `scale`; the file is not read at a scale that makes no solid
   MeshFile file = readMeshFile(ctx, uri, mesh.scale);
@@ -244,12 +233,9 @@ RobotCollidersDef readRobotColliders(const Context& ctx, const Field& field)
 {
   requireMap(ctx, field, { "param", "friction", "restitution" });
   RobotCollidersDef robot;
-  if (const std::optional<Field> value = optionalKey(field, "param"))
-    robot.param = readNonEmptyString(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "friction"))
-    robot.friction = readNonNegative(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "restitution"))
-    robot.restitution = readFraction(ctx, *value);
+  readOptional(ctx, field, "param", robot.param, readNonEmptyString);
+  readOptional(ctx, field, "friction", robot.friction, readNonNegative);
+  readOptional(ctx, field, "restitution", robot.restitution, readFraction);
   return robot;
 }
 
@@ -268,8 +254,7 @@ void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
       if (other.name == anchor.name)
         ctx.fail(name, "duplicate anchor name " + quoted(anchor.name));
     anchor.node = readNodeIndex(ctx, requiredKey(ctx, item, "node"), static_cast<int>(count));
-    if (const std::optional<Field> frame = optionalKey(item, "frame"))
-      anchor.frame = readFrameId(ctx, *frame);
+    readOptional(ctx, item, "frame", anchor.frame, readFrameId);
     body.anchors.push_back(anchor);
   }
 }
@@ -302,12 +287,9 @@ SceneDef readScene(const Context& ctx, const Field& root, const SceneLimits& lim
                        (root.node.IsNull() ? "an empty document" : describe(root.node)));
   requireMap(ctx, root, kSceneKeys);
   SceneDef scene;
-  if (const std::optional<Field> value = optionalKey(root, "frame_id"))
-    scene.frame_id = readNonEmptyString(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(root, "rate"))
-    scene.rate = readPositive(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(root, "physics"))
-    scene.physics = readPhysics(ctx, *value);
+  readOptional(ctx, root, "frame_id", scene.frame_id, readNonEmptyString);
+  readOptional(ctx, root, "rate", scene.rate, readPositive);
+  readOptional(ctx, root, "physics", scene.physics, readPhysics);
   if (const std::optional<Field> planes = optionalKey(root, "planes"))
     for (const Field& item : requireList(ctx, *planes))
       scene.colliders.planes.push_back(readPlane(ctx, item));
@@ -325,8 +307,7 @@ SceneDef readScene(const Context& ctx, const Field& root, const SceneLimits& lim
     }
   }
 
-  if (const std::optional<Field> robot = optionalKey(root, "robot_colliders"))
-    scene.robot_colliders = readRobotColliders(ctx, *robot);
+  readOptional(ctx, root, "robot_colliders", scene.robot_colliders, readRobotColliders);
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error

@@ -73,6 +73,15 @@ void requireMap(const Context& ctx, const Field& field, const Keys& allowed);
 /// The value under `key` of a mapping checked by requireMap; nullopt if absent.
 std::optional<Field> optionalKey(const Field& map, const std::string& key);
 Field requiredKey(const Context& ctx, const Field& map, const std::string& key);
+/// An optional key: the value under `key` of a mapping checked by requireMap, read into `target` by `read`
+/// (readNumber, readVec3, ... any `T read(const Context&, const Field&)`), whose errors name the key's path
+/// and line; an absent key leaves `target` as it was, the definition's default.
+template <typename T, typename Read>
+void readOptional(const Context& ctx, const Field& map, const std::string& key, T& target, Read read)
+{
+  if (const std::optional<Field> value = optionalKey(map, key))
+    target = read(ctx, *value);
+}
 std::vector<Field> requireList(const Context& ctx, const Field& field, const std::string& expected = "a list");
 std::vector<Field> requireListOfSize(const Context& ctx, const Field& field, std::size_t size,
                                      const std::string& what);

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The demo in a real rviz under Xvfb (rviz_screenshot.test). Each body is drawn in its own colour,
-a golden-angle hue per body index (bodyColor in src/ros/ros_converter.cpp); the demo's bodies stand
+a golden-angle hue per body index (bodyColor in src/ros/marker_conversion.cpp); the demo's bodies stand
 left to right along x in the order of the scene file, seen from -y. The test takes a screenshot of
 the virtual screen and checks that every body's colour is there, in enough pixels, in that order from
 left to right. SOFT_BODY_SIM_SCREENSHOT=FILE keeps the screenshot (the README's docs/demo.png)."""

@@ -1,6 +1,7 @@
 // Every conversion between the core and ROS messages, in one place (as grid_map's
-// GridMapRosConverter): markers and state out, poses in. Plain functions of plain data, unit-tested
-// without a ROS master.
+// GridMapRosConverter): markers and state out, poses in, reconfigure configs both ways. Plain functions
+// of plain data, unit-tested without a ROS master. One class, a source file per kind of message:
+// src/ros/marker_conversion.cpp, state_conversion.cpp, pose_conversion.cpp, reconfigure_conversion.cpp.
 #pragma once
 
 #include <string>
@@ -8,6 +9,7 @@
 
 #include <optional>
 
+#include <geometry_msgs/Point.h>
 #include <geometry_msgs/Pose.h>
 #include <geometry_msgs/Transform.h>
 #include <geometry_msgs/Vector3.h>
@@ -42,6 +44,8 @@ struct Holder
 class RosConverter
 {
 public:
+  // --- rviz markers (marker_conversion.cpp) ---
+
   /// One namespace per body (its name): id 0 a SPHERE_LIST of its nodes in node order, id 1 a
   /// LINE_LIST of its springs and constraints, ids 2.. a LINE_STRIP per curve of its controller (limbs);
   /// and namespace "colliders": each sphere, capsule and box in its current pose (a capsule as a
@@ -56,6 +60,8 @@ public:
   static visualization_msgs::MarkerArray toForceMarkers(const std::vector<Holder>& holders, double force_scale,
                                                         const std::string& frame_id, const ros::Time& stamp);
 
+  // --- the state and the holders' wrenches (state_conversion.cpp) ---
+
   /// The state: per body its name, positions [m], velocities [m/s], integrator, what the divergence guard
   /// did to it, its holders (`holders`, see holders()) and their wrenches, its links' tensions and the
   /// `slips` of its grasps; and the step statistics.
@@ -65,6 +71,8 @@ public:
   /// Every anchor (model order), then every grasp, with the wrench its body exerts on it.
   static std::vector<Holder> holders(const World& world);
   static geometry_msgs::WrenchStamped toWrench(const Wrench& wrench, const std::string& frame_id, const ros::Time& stamp);
+
+  // --- poses and points (pose_conversion.cpp) ---
 
   /// The position [m] of a pose; false (and why) if any field of the pose is NaN or infinite.
   static bool fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why);
@@ -79,9 +87,15 @@ public:
   static Vec3 toVec3(const geometry_msgs::Point& point) { return Vec3(point.x, point.y, point.z); }
   /// A translation [m], as it is.
   static Vec3 toVec3(const geometry_msgs::Vector3& vector) { return Vec3(vector.x, vector.y, vector.z); }
+  /// A position [m] as a message point, as it is (the inverse of toVec3).
+  static geometry_msgs::Point toPoint(const Vec3& p) { return xyzMessage<geometry_msgs::Point>(p); }
+  /// A vector (a velocity [m/s], a force [N], a torque [N m]) as a message vector, as it is.
+  static geometry_msgs::Vector3 toVector3(const Vec3& v) { return xyzMessage<geometry_msgs::Vector3>(v); }
 
   /// A transform as a rigid pose; nullopt if any field is not finite or the rotation is zero.
   static std::optional<RigidPose> toRigidPose(const geometry_msgs::Transform& transform);
+
+  // --- dynamic_reconfigure configs (reconfigure_conversion.cpp) ---
 
   /// The world's live physics as the node's reconfigure config (~): integrator, dt, substeps,
   /// iterations, gravity, drag.
@@ -98,6 +112,18 @@ public:
   static BodyScaling toBodyScaling(const BodyConfig& config)
   {
     return BodyScaling{ config.stiffness_scale, config.damping_scale, config.pressure_scale };
+  }
+
+private:
+  /// A message of three fields x, y, z (a point, a vector) holding `v`.
+  template <typename Message>
+  static Message xyzMessage(const Vec3& v)
+  {
+    Message out;
+    out.x = v.x();
+    out.y = v.y();
+    out.z = v.z();
+    return out;
   }
 };
 

@@ -18,12 +18,10 @@ BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& 
   cloth.mass = readNumber(ctx, requiredKey(ctx, field, "mass"));
   cloth.structural = readSpringParameters(ctx, requiredKey(ctx, field, "structural"));
   cloth.shear = readSpringParameters(ctx, requiredKey(ctx, field, "shear"));
-  if (const std::optional<Field> value = optionalKey(field, "bending"))
-    cloth.bending = readSpringParameters(ctx, *value);
+  readOptional(ctx, field, "bending", cloth.bending, readSpringParameters);
   if (const std::optional<Field> value = optionalKey(field, "pinned"))
     cloth.pinned = readPinned(ctx, *value, cloth.nx * cloth.ny, cloth.nx, cloth.ny);
-  if (const std::optional<Field> value = optionalKey(field, "thickness"))
-    cloth.thickness = readNumber(ctx, *value);
+  readOptional(ctx, field, "thickness", cloth.thickness, readNumber);
   readSelfContact(ctx, field, cloth);
   return buildBody(ctx, field, cloth, buildCloth);
 }

@@ -19,14 +19,12 @@ TendrilDef readTendrils(const Context& ctx, const Field& field)
 {
   requireMap(ctx, field, kTendrilKeys);
   TendrilDef tendrils;
-  if (const std::optional<Field> value = optionalKey(field, "segments"))
-    tendrils.segments = readInt(ctx, *value);
-  for (auto [key, target] : { std::pair{ "length", &tendrils.length }, std::pair{ "mass", &tendrils.mass },
-                              std::pair{ "stiffness", &tendrils.stiffness }, std::pair{ "damping", &tendrils.damping } })
-    if (const std::optional<Field> value = optionalKey(field, key))
-      *target = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "direction"))
-    tendrils.direction = readVec3(ctx, *value);
+  readOptional(ctx, field, "segments", tendrils.segments, readInt);
+  readOptional(ctx, field, "length", tendrils.length, readNumber);
+  readOptional(ctx, field, "mass", tendrils.mass, readNumber);
+  readOptional(ctx, field, "stiffness", tendrils.stiffness, readNumber);
+  readOptional(ctx, field, "damping", tendrils.damping, readNumber);
+  readOptional(ctx, field, "direction", tendrils.direction, readVec3);
   return tendrils;
 }
 
@@ -36,40 +34,29 @@ BodyDef readCreatureBody(const Context& ctx, const Field& field, const SceneSoFa
 {
   requireMap(ctx, field, withCommonBodyKeys(kCreatureKeys));
   CreatureDef def;
-  for (auto [key, target] : { std::pair{ "position", &def.position }, std::pair{ "heading", &def.heading },
-                              std::pair{ "plane_normal", &def.plane_normal } })
-    if (const std::optional<Field> value = optionalKey(field, key))
-      *target = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "target"))
-    def.target = readVec3(ctx, *value);
-  for (auto [key, target] : { std::pair{ "length", &def.length },
-                              std::pair{ "width", &def.width },
-                              std::pair{ "update_period", &def.update_period },
-                              std::pair{ "stiffness", &def.stiffness },
-                              std::pair{ "lead_retention", &def.lead_retention },
-                              std::pair{ "anticipation", &def.anticipation },
-                              std::pair{ "settle_tolerance", &def.settle_tolerance },
-                              std::pair{ "parallel_retention", &def.parallel_retention },
-                              std::pair{ "perpendicular_retention", &def.perpendicular_retention },
-                              std::pair{ "side_retention", &def.side_retention },
-                              std::pair{ "min_ratio", &def.min_ratio },
-                              std::pair{ "max_ratio", &def.max_ratio },
-                              std::pair{ "soft_strength", &def.soft_strength },
-                              std::pair{ "hard_strength", &def.hard_strength } })
-    if (const std::optional<Field> value = optionalKey(field, key))
-      *target = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "iterations"))
-    def.iterations = readInt(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "tendrils"))
-  {
-    def.tendrils = readTendrils(ctx, *value);
-    scene.requireNodes(ctx, firstPresent(*value, { "segments" }),
-                       kCreatureBodyPoints + 2LL * std::max(0, def.tendrils->segments));
-  }
-  else
-  {
-    scene.requireNodes(ctx, field, kCreatureBodyPoints);
-  }
+  readOptional(ctx, field, "position", def.position, readVec3);
+  readOptional(ctx, field, "heading", def.heading, readVec3);
+  readOptional(ctx, field, "plane_normal", def.plane_normal, readVec3);
+  readOptional(ctx, field, "target", def.target, readVec3);
+  readOptional(ctx, field, "length", def.length, readNumber);
+  readOptional(ctx, field, "width", def.width, readNumber);
+  readOptional(ctx, field, "update_period", def.update_period, readNumber);
+  readOptional(ctx, field, "stiffness", def.stiffness, readNumber);
+  readOptional(ctx, field, "lead_retention", def.lead_retention, readNumber);
+  readOptional(ctx, field, "anticipation", def.anticipation, readNumber);
+  readOptional(ctx, field, "settle_tolerance", def.settle_tolerance, readNumber);
+  readOptional(ctx, field, "parallel_retention", def.parallel_retention, readNumber);
+  readOptional(ctx, field, "perpendicular_retention", def.perpendicular_retention, readNumber);
+  readOptional(ctx, field, "side_retention", def.side_retention, readNumber);
+  readOptional(ctx, field, "min_ratio", def.min_ratio, readNumber);
+  readOptional(ctx, field, "max_ratio", def.max_ratio, readNumber);
+  readOptional(ctx, field, "soft_strength", def.soft_strength, readNumber);
+  readOptional(ctx, field, "hard_strength", def.hard_strength, readNumber);
+  readOptional(ctx, field, "iterations", def.iterations, readInt);
+  readOptional(ctx, field, "tendrils", def.tendrils, readTendrils);
+  // Without tendrils, the count is the body's alone and an error points at the body.
+  scene.requireNodes(ctx, firstPresent(field, { "tendrils.segments", "tendrils" }),
+                     kCreatureBodyPoints + (def.tendrils ? 2LL * std::max(0, def.tendrils->segments) : 0LL));
 
   // The creature makes every update due in a step, however many (a `dt: auto` step is only known when the
   // world is built, so only a given dt is checked): a check of the body against the scene's physics.

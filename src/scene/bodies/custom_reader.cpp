@@ -15,10 +15,8 @@ NodeDef readNode(const Context& ctx, const Field& field)
   NodeDef node;
   node.position = readVec3(ctx, requiredKey(ctx, field, "position"));
   node.mass = readPositive(ctx, requiredKey(ctx, field, "mass"));
-  if (const std::optional<Field> value = optionalKey(field, "velocity"))
-    node.velocity = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "pinned"))
-    node.pinned = readBool(ctx, *value);
+  readOptional(ctx, field, "velocity", node.velocity, readVec3);
+  readOptional(ctx, field, "pinned", node.pinned, readBool);
   return node;
 }
 
@@ -32,8 +30,7 @@ void readLinkEnds(const Context& ctx, const Field& field, std::size_t node_count
   link.b = readNodeIndex(ctx, items[1], node_count);
   if (link.a == link.b)
     ctx.fail(ends, "connects node " + std::to_string(link.a) + " to itself");
-  if (const std::optional<Field> value = optionalKey(field, "rest_length"))
-    link.rest_length = readNonNegative(ctx, *value);
+  readOptional(ctx, field, "rest_length", link.rest_length, readNonNegative);
 }
 
 SpringDef readSpring(const Context& ctx, const Field& field, std::size_t node_count)
@@ -42,8 +39,7 @@ SpringDef readSpring(const Context& ctx, const Field& field, std::size_t node_co
   SpringDef spring;
   readLinkEnds(ctx, field, node_count, spring);
   spring.stiffness = readPositive(ctx, requiredKey(ctx, field, "stiffness"));
-  if (const std::optional<Field> value = optionalKey(field, "damping"))
-    spring.damping = readNonNegative(ctx, *value);
+  readOptional(ctx, field, "damping", spring.damping, readNonNegative);
   return spring;
 }
 
@@ -52,8 +48,7 @@ ConstraintDef readConstraint(const Context& ctx, const Field& field, std::size_t
   requireMap(ctx, field, kConstraintKeys);
   ConstraintDef constraint;
   readLinkEnds(ctx, field, node_count, constraint);
-  if (const std::optional<Field> value = optionalKey(field, "compliance"))
-    constraint.compliance = readNonNegative(ctx, *value);
+  readOptional(ctx, field, "compliance", constraint.compliance, readNonNegative);
   return constraint;
 }
 
@@ -77,8 +72,7 @@ BodyDef readCustomBody(const Context& ctx, const Field& field, const SceneSoFar&
   if (const std::optional<Field> constraints = optionalKey(field, "constraints"))
     for (const Field& item : requireList(ctx, *constraints))
       body.constraints.push_back(readConstraint(ctx, item, body.nodes.size()));
-  if (const std::optional<Field> value = optionalKey(field, "radius"))
-    body.contact_radius = readNonNegative(ctx, *value);
+  readOptional(ctx, field, "radius", body.contact_radius, readNonNegative);
   return body;
 }
 

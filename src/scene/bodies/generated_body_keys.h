@@ -37,8 +37,7 @@ inline SpringParameters readSpringParameters(const Context& ctx, const Field& fi
   requireMap(ctx, field, { "stiffness", "damping" });
   SpringParameters spring;
   spring.stiffness = readNumber(ctx, requiredKey(ctx, field, "stiffness"));
-  if (const std::optional<Field> value = optionalKey(field, "damping"))
-    spring.damping = readNumber(ctx, *value);
+  readOptional(ctx, field, "damping", spring.damping, readNumber);
   return spring;
 }
 
@@ -47,10 +46,8 @@ inline SpringParameters readSpringParameters(const Context& ctx, const Field& fi
 template <typename Def>
 void readSelfContact(const Context& ctx, const Field& body, Def& def)
 {
-  if (const std::optional<Field> value = optionalKey(body, "self_collision"))
-    def.self_collision = readBool(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(body, "self_friction"))
-    def.self_friction = readNumber(ctx, *value);
+  readOptional(ctx, body, "self_collision", def.self_collision, readBool);
+  readOptional(ctx, body, "self_friction", def.self_friction, readNumber);
 }
 
 /// The required keys top_left, top_right and bottom_left [m] of a grid body.

@@ -1,6 +1,4 @@
 // `type: humanoid`: a torso following a target with four Bezier limbs (see core/bodies/humanoid.h).
-#include <iterator>
-
 #include <Eigen/Geometry>  // cross products
 
 #include "scene/body_readers.h"
@@ -27,25 +25,18 @@ BodyDef readHumanoidBody(const Context& ctx, const Field& field, const SceneSoFa
   requireMap(ctx, field, withCommonBodyKeys(humanoidKeys()));
   scene.requireNodes(ctx, field, kHumanoidNodes);
   HumanoidDef def;
-  if (const std::optional<Field> value = optionalKey(field, "position"))
-    def.position = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "target"))
-    def.target = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "up"))
-    def.up = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "facing"))
-    def.facing = readVec3(ctx, *value);
-  double* const lengths[] = { &def.torso_length, &def.head_height, &def.shoulder_width,
-                              &def.hip_width,    &def.arm_length,  &def.leg_length };
-  const char* const length_keys[] = { "torso_length", "head_height", "shoulder_width",
-                                      "hip_width",    "arm_length",  "leg_length" };
-  for (std::size_t k = 0; k < std::size(lengths); ++k)
-    if (const std::optional<Field> value = optionalKey(field, length_keys[k]))
-      *lengths[k] = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "torso_stiffness"))
-    def.torso_stiffness = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "torso_retention"))
-    def.torso_retention = readNumber(ctx, *value);
+  readOptional(ctx, field, "position", def.position, readVec3);
+  readOptional(ctx, field, "target", def.target, readVec3);
+  readOptional(ctx, field, "up", def.up, readVec3);
+  readOptional(ctx, field, "facing", def.facing, readVec3);
+  readOptional(ctx, field, "torso_length", def.torso_length, readNumber);
+  readOptional(ctx, field, "head_height", def.head_height, readNumber);
+  readOptional(ctx, field, "shoulder_width", def.shoulder_width, readNumber);
+  readOptional(ctx, field, "hip_width", def.hip_width, readNumber);
+  readOptional(ctx, field, "arm_length", def.arm_length, readNumber);
+  readOptional(ctx, field, "leg_length", def.leg_length, readNumber);
+  readOptional(ctx, field, "torso_stiffness", def.torso_stiffness, readNumber);
+  readOptional(ctx, field, "torso_retention", def.torso_retention, readNumber);
   readLimbMotion(ctx, field, def.limbs);
 
   return buildBody(ctx, field, def, buildHumanoid);

@@ -20,8 +20,7 @@ BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& 
   jelly.edges = readSpringParameters(ctx, requiredKey(ctx, field, "edges"));
   jelly.diagonals = readSpringParameters(ctx, requiredKey(ctx, field, "diagonals"));
   jelly.pressure = readNumber(ctx, requiredKey(ctx, field, "pressure"));
-  if (const std::optional<Field> value = optionalKey(field, "thickness"))
-    jelly.thickness = readNumber(ctx, *value);
+  readOptional(ctx, field, "thickness", jelly.thickness, readNumber);
   readSelfContact(ctx, field, jelly);
   return buildBody(ctx, field, jelly, buildJelly);
 }

@@ -27,17 +27,13 @@ const Keys& limbMotionKeys()
 
 void readLimbMotion(const Context& ctx, const Field& body, LimbMotion& motion)
 {
-  if (const std::optional<Field> value = optionalKey(body, "gravity"))
-    motion.gravity = readVec3(ctx, *value);
-  for (auto [key, target] : { std::pair{ "frame_period", &motion.frame_period },
-                              std::pair{ "max_frames_per_step", &motion.max_frames_per_step },
-                              std::pair{ "tension", &motion.tension }, std::pair{ "retention", &motion.retention } })
-    if (const std::optional<Field> value = optionalKey(body, key))
-      *target = readNumber(ctx, *value);
-  for (auto [key, target] : { std::pair{ "iterations", &motion.iterations },
-                              std::pair{ "curve_samples", &motion.curve_samples } })
-    if (const std::optional<Field> value = optionalKey(body, key))
-      *target = readInt(ctx, *value);
+  readOptional(ctx, body, "gravity", motion.gravity, readVec3);
+  readOptional(ctx, body, "frame_period", motion.frame_period, readNumber);
+  readOptional(ctx, body, "max_frames_per_step", motion.max_frames_per_step, readNumber);
+  readOptional(ctx, body, "tension", motion.tension, readNumber);
+  readOptional(ctx, body, "retention", motion.retention, readNumber);
+  readOptional(ctx, body, "iterations", motion.iterations, readInt);
+  readOptional(ctx, body, "curve_samples", motion.curve_samples, readInt);
 }
 
 BodyDef readLimbBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
@@ -45,14 +41,10 @@ BodyDef readLimbBody(const Context& ctx, const Field& field, const SceneSoFar& s
   requireMap(ctx, field, withCommonBodyKeys(limbKeys()));
   scene.requireNodes(ctx, field, kLimbLeaf + 1);
   LimbDef def;
-  if (const std::optional<Field> value = optionalKey(field, "root"))
-    def.root = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "direction"))
-    def.direction = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "upper_length"))
-    def.upper_length = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "lower_length"))
-    def.lower_length = readNumber(ctx, *value);
+  readOptional(ctx, field, "root", def.root, readVec3);
+  readOptional(ctx, field, "direction", def.direction, readVec3);
+  readOptional(ctx, field, "upper_length", def.upper_length, readNumber);
+  readOptional(ctx, field, "lower_length", def.lower_length, readNumber);
   readLimbMotion(ctx, field, def.motion);
 
   return buildBody(ctx, field, def, buildLimb);

@@ -16,15 +16,12 @@ BodyDef readRodBody(const Context& ctx, const Field& field, const SceneSoFar& sc
   rod.to = readVec3(ctx, requiredKey(ctx, field, "to"));
   rod.radius = readNumber(ctx, requiredKey(ctx, field, "radius"));
   rod.youngs_modulus = readNumber(ctx, requiredKey(ctx, field, "youngs_modulus"));
-  if (const std::optional<Field> value = optionalKey(field, "shear_modulus"))
-    rod.shear_modulus = readNumber(ctx, *value);
+  readOptional(ctx, field, "shear_modulus", rod.shear_modulus, readNumber);
   rod.density = readNumber(ctx, requiredKey(ctx, field, "density"));
-  if (const std::optional<Field> value = optionalKey(field, "damping"))
-    rod.damping = readNumber(ctx, *value);
+  readOptional(ctx, field, "damping", rod.damping, readNumber);
   if (const std::optional<Field> value = optionalKey(field, "clamped"))
     rod.clamped = readPinned(ctx, *value, rod.nodes);
-  if (const std::optional<Field> value = optionalKey(field, "end_moment"))
-    rod.end_moment = readVec3(ctx, *value);
+  readOptional(ctx, field, "end_moment", rod.end_moment, readVec3);
   readSelfContact(ctx, field, rod);
   return buildBody(ctx, field, rod, buildRod);
 }

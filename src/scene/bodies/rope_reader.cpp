@@ -33,18 +33,14 @@ BodyDef readRopeBody(const Context& ctx, const Field& field, const SceneSoFar& s
   rope.mass = readNumber(ctx, requiredKey(ctx, field, "mass"));
   rope.stiffness = readNumber(ctx, requiredKey(ctx, field, "stiffness"));
   rope.damping = 0.0;
-  if (const std::optional<Field> value = optionalKey(field, "damping"))
-    rope.damping = readNumber(ctx, *value);
+  readOptional(ctx, field, "damping", rope.damping, readNumber);
   rope.bending = 0.0;
-  if (const std::optional<Field> value = optionalKey(field, "bending"))
-    rope.bending = readNumber(ctx, *value);
+  readOptional(ctx, field, "bending", rope.bending, readNumber);
   rope.bending_damping = 0.0;
-  if (const std::optional<Field> value = optionalKey(field, "bending_damping"))
-    rope.bending_damping = readNumber(ctx, *value);
+  readOptional(ctx, field, "bending_damping", rope.bending_damping, readNumber);
   if (const std::optional<Field> value = optionalKey(field, "pinned"))
     rope.pinned = readPinned(ctx, *value, rope.nodes);
-  if (const std::optional<Field> value = optionalKey(field, "radius"))
-    rope.radius = readNumber(ctx, *value);
+  readOptional(ctx, field, "radius", rope.radius, readNumber);
   readSelfContact(ctx, field, rope);
   return buildBody(ctx, field, rope, buildRope);
 }

@@ -42,10 +42,8 @@ BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar&
                                               "youngs_modulus", "poisson_ratio", "density", "pinned", "friction", "pressure" }));
   VolumeDef volume;
   volume.shape = readVolumeShape(ctx, requiredKey(ctx, field, "shape"));
-  if (const std::optional<Field> value = optionalKey(field, "size"))
-    volume.size = readVec3(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "radius"))
-    volume.radius = readNumber(ctx, *value);
+  readOptional(ctx, field, "size", volume.size, readVec3);
+  readOptional(ctx, field, "radius", volume.radius, readNumber);
   if (const std::optional<Field> value = optionalKey(field, "mesh"))
   {
     volume.mesh = readNonEmptyString(ctx, *value);
@@ -56,15 +54,12 @@ BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar&
   volume.resolution = readNumber(ctx, resolution);
   volume.position = readVec3(ctx, requiredKey(ctx, field, "position"));
   volume.youngs_modulus = readNumber(ctx, requiredKey(ctx, field, "youngs_modulus"));
-  if (const std::optional<Field> value = optionalKey(field, "poisson_ratio"))
-    volume.poisson_ratio = readNumber(ctx, *value);
+  readOptional(ctx, field, "poisson_ratio", volume.poisson_ratio, readNumber);
   volume.density = readNumber(ctx, requiredKey(ctx, field, "density"));
   if (const std::optional<Field> value = optionalKey(field, "pinned"))
     readPinnedNodesAndFaces(ctx, *value, volume);
-  if (const std::optional<Field> value = optionalKey(field, "friction"))
-    volume.friction = readNumber(ctx, *value);
-  if (const std::optional<Field> value = optionalKey(field, "pressure"))
-    volume.pressure = readNumber(ctx, *value);
+  readOptional(ctx, field, "friction", volume.friction, readNumber);
+  readOptional(ctx, field, "pressure", volume.pressure, readNumber);
   volume.max_tetrahedra = scene.max_tetrahedra;
   BodyDef body = buildBody(ctx, field, volume, buildVolume);
   // The node count is known only after meshing; the mesher's own limit (max_tetrahedra) bounds the memory

@@ -1,3 +1,5 @@
+// RosConverter: the rviz markers of the bodies (nodes, links, rods, solids, controllers' curves), of the
+// colliders and of the forces on the holders.
 #include "soft_body_sim/ros/ros_converter.h"
 
 #include <algorithm>
@@ -44,15 +46,6 @@ visualization_msgs::Marker marker(const std::string& frame_id, const ros::Time& 
   return m;
 }
 
-geometry_msgs::Point point(const Vec3& p)
-{
-  geometry_msgs::Point out;
-  out.x = p.x();
-  out.y = p.y();
-  out.z = p.z();
-  return out;
-}
-
 /// A grey solid for the colliders, a little transparent so that a body behind one stays visible.
 std_msgs::ColorRGBA colliderColor()
 {
@@ -65,7 +58,7 @@ std_msgs::ColorRGBA colliderColor()
 geometry_msgs::Pose pose(const Vec3& position, const Eigen::Quaterniond& orientation)
 {
   geometry_msgs::Pose out;
-  out.position = point(position);
+  out.position = RosConverter::toPoint(position);
   out.orientation.x = orientation.x();
   out.orientation.y = orientation.y();
   out.orientation.z = orientation.z();
@@ -120,17 +113,8 @@ void addSegment(const NodeArray& x, int a, int b, visualization_msgs::Marker& li
 {
   if (!x.col(a).allFinite() || !x.col(b).allFinite())
     return;
-  lines.points.push_back(point(x.col(a)));
-  lines.points.push_back(point(x.col(b)));
-}
-
-geometry_msgs::Vector3 vector3(const Vec3& v)
-{
-  geometry_msgs::Vector3 out;
-  out.x = v.x();
-  out.y = v.y();
-  out.z = v.z();
-  return out;
+  lines.points.push_back(RosConverter::toPoint(x.col(a)));
+  lines.points.push_back(RosConverter::toPoint(x.col(b)));
 }
 
 }  // namespace
@@ -163,7 +147,7 @@ void addRodMarkers(const World& world, const std::string& frame_id, const ros::T
       const Vec3 p = x.col(rod.first + j);
       if (!p.allFinite())
         continue;
-      strip.points.push_back(point(p));
+      strip.points.push_back(RosConverter::toPoint(p));
       if (j + 1 == rod.count || !x.col(rod.first + j + 1).allFinite())
         continue;
       const Vec3 middle = 0.5 * (p + x.col(rod.first + j + 1));
@@ -175,8 +159,8 @@ void addRodMarkers(const World& world, const std::string& frame_id, const ros::T
         color.g = c == 1 ? 1.0f : 0.0f;
         color.b = c == 2 ? 1.0f : 0.0f;
         color.a = 1.0f;
-        axes.points.push_back(point(middle));
-        axes.points.push_back(point(middle + length * axis.col(c)));
+        axes.points.push_back(RosConverter::toPoint(middle));
+        axes.points.push_back(RosConverter::toPoint(middle + length * axis.col(c)));
         axes.colors.push_back(color);
         axes.colors.push_back(color);
       }
@@ -211,7 +195,7 @@ void addVolumeMarkers(const World& world, const std::string& frame_id, const ros
     for (const std::array<int, 3>& t : body.surface)
       if (x.col(t[0]).allFinite() && x.col(t[1]).allFinite() && x.col(t[2]).allFinite())
         for (const int node : t)
-          triangles.points.push_back(point(x.col(node)));
+          triangles.points.push_back(RosConverter::toPoint(x.col(node)));
     if (triangles.points.empty())
       triangles.action = visualization_msgs::Marker::DELETE;
     array.markers.push_back(triangles);
@@ -241,7 +225,7 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
     {
       body_of_node[static_cast<std::size_t>(i)] = rod ? -1 : static_cast<int>(b);
       if (!rod && x.col(i).allFinite())
-        nodes.points.push_back(point(x.col(i)));
+        nodes.points.push_back(toPoint(x.col(i)));
     }
     array.markers.push_back(nodes);
     array.markers.push_back(
@@ -272,7 +256,7 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
                                                 2.0 * kLineWidth, bodyColor(static_cast<std::size_t>(controlled.body)));
       for (const Vec3& p : curve)
         if (p.allFinite())
-          strip.points.push_back(point(p));
+          strip.points.push_back(toPoint(p));
       array.markers.push_back(strip);
     }
   }
@@ -298,167 +282,10 @@ visualization_msgs::MarkerArray RosConverter::toForceMarkers(const std::vector<H
     arrow.scale.x = kLineWidth;        // shaft diameter [m]
     arrow.scale.y = 2.0 * kLineWidth;  // head diameter
     arrow.scale.z = 0.0;               // head length: rviz's default share of the arrow
-    arrow.points = { point(holders[k].origin), point(holders[k].origin + force_scale * holders[k].wrench.force) };
+    arrow.points = { toPoint(holders[k].origin), toPoint(holders[k].origin + force_scale * holders[k].wrench.force) };
     array.markers.push_back(arrow);
   }
   return array;
-}
-
-std::vector<Holder> RosConverter::holders(const World& world)
-{
-  std::vector<Holder> holders;
-  const Model& model = world.model();
-  const std::vector<Wrench> anchors = world.anchorWrenches();
-  for (std::size_t k = 0; k < anchors.size(); ++k)
-  {
-    const Anchor& anchor = model.anchors[k];
-    holders.push_back({ model.bodyOf(anchor.node), anchor.name, world.state().position.col(anchor.node), anchors[k] });
-  }
-  const std::vector<Wrench> grasps = world.graspWrenches();
-  for (std::size_t k = 0; k < grasps.size(); ++k)
-  {
-    const GraspedNodes& grasp = world.grasps()[k];
-    holders.push_back({ grasp.body, grasp.name, grasp.pose.position, grasps[k] });
-  }
-  return holders;
-}
-
-geometry_msgs::WrenchStamped RosConverter::toWrench(const Wrench& wrench, const std::string& frame_id,
-                                                    const ros::Time& stamp)
-{
-  geometry_msgs::WrenchStamped out;
-  out.header.frame_id = frame_id;
-  out.header.stamp = stamp;
-  out.wrench.force = vector3(wrench.force);
-  out.wrench.torque = vector3(wrench.torque);
-  return out;
-}
-
-SimState RosConverter::toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
-                               const StepStatistics& statistics, const std::vector<Holder>& holders,
-                               const std::vector<GraspSlip>& slips)
-{
-  const Model& model = world.model();
-  const Eigen::VectorXd tension = world.linkTensions();
-  SimState state;
-  state.header.frame_id = frame_id;
-  state.header.stamp = stamp;
-  state.real_time_factor = statistics.real_time_factor;
-  state.wall_seconds_per_step = statistics.wall_seconds_per_step;
-  state.divergence_events = statistics.divergence_events;
-  for (std::size_t b = 0; b < world.model().bodies.size(); ++b)
-  {
-    const BodyRange& range = world.model().bodies[b];
-    BodyState body;
-    body.name = range.name;
-    body.integrator = integratorName(world.bodyIntegrator(b));
-    body.divergence_events = static_cast<std::uint32_t>(world.divergenceCount(b));
-    body.frozen = world.isFrozen(b);
-    for (int i = range.first; i < range.first + range.count; ++i)
-    {
-      body.positions.push_back(point(world.state().position.col(i)));
-      body.velocities.push_back(vector3(world.state().velocity.col(i)));
-    }
-    for (const Holder& holder : holders)
-      if (holder.body == b)
-      {
-        body.holders.push_back(holder.name);
-        geometry_msgs::Wrench wrench;
-        wrench.force = vector3(holder.wrench.force);
-        wrench.torque = vector3(holder.wrench.torque);
-        body.wrenches.push_back(wrench);
-      }
-    for (const GraspSlip& slip : slips)
-      if (slip.body == range.name)
-        body.slips.push_back(slip.describe());
-    state.bodies.push_back(body);
-  }
-  // A link belongs to the body of its first node; buildWorld adds each body's links in order.
-  for (std::size_t k = 0; k < model.springs.size(); ++k)
-    state.bodies[model.bodyOf(model.springs[k].a)].tensions.push_back(tension[static_cast<Eigen::Index>(k)]);
-  for (std::size_t k = 0; k < model.constraints.size(); ++k)
-    state.bodies[model.bodyOf(model.constraints[k].a)].tensions.push_back(
-        tension[static_cast<Eigen::Index>(model.springs.size() + k)]);
-  return state;
-}
-
-geometry_msgs::Pose RosConverter::toPose(const Vec3& position)
-{
-  geometry_msgs::Pose pose;
-  pose.position.x = position.x();
-  pose.position.y = position.y();
-  pose.position.z = position.z();
-  pose.orientation.w = 1.0;
-  return pose;
-}
-
-bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why)
-{
-  const Vec3 p = toVec3(pose.position);
-  const Eigen::Vector4d q(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w);
-  if (!p.allFinite())
-  {
-    why = "position is not finite";
-    return false;
-  }
-  if (!q.allFinite())
-  {
-    why = "orientation is not finite";
-    return false;
-  }
-  position = p;
-  return true;
-}
-
-bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position,
-                            std::optional<Eigen::Quaterniond>& orientation, std::string& why)
-{
-  if (!fromPose(pose, position, why))
-    return false;
-  const Eigen::Quaterniond q(pose.orientation.w, pose.orientation.x, pose.orientation.y, pose.orientation.z);
-  orientation.reset();
-  if (q.norm() > 1e-12)
-    orientation = q.normalized();
-  return true;
-}
-
-std::optional<RigidPose> RosConverter::toRigidPose(const geometry_msgs::Transform& transform)
-{
-  RigidPose pose;
-  pose.position = toVec3(transform.translation);
-  pose.orientation = Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y,
-                                        transform.rotation.z);
-  if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite() || !(pose.orientation.norm() > 1e-12))
-    return std::nullopt;
-  pose.orientation.normalize();
-  return pose;
-}
-
-SimConfig RosConverter::toSimConfig(const World& world)
-{
-  SimConfig config = SimConfig::__getDefault__();
-  config.integrator = integratorName(world.integrator());
-  config.dt = world.settings().dt;
-  config.substeps = world.settings().substeps;
-  config.iterations = world.settings().iterations;
-  config.gravity_x = world.model().gravity.x();
-  config.gravity_y = world.model().gravity.y();
-  config.gravity_z = world.model().gravity.z();
-  config.drag = world.model().drag;
-  return config;
-}
-
-bool RosConverter::integratorOf(const SimConfig& config, IntegratorType& integrator, std::string& why)
-{
-  if (integratorFromName(config.integrator, integrator))
-    return true;
-  // Quoted back only as far as a name could be: the request may hold megabytes.
-  const std::size_t shown = 32;
-  why = "integrator '" + config.integrator.substr(0, shown) + (config.integrator.size() > shown ? "...'" : "'") +
-        " is unknown; valid:";
-  for (const std::string& name : integratorNames())
-    why += " " + name;
-  return false;
 }
 
 }  // namespace soft_body_sim

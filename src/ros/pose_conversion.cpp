@@ -1,0 +1,58 @@
+// RosConverter: poses and transforms in (checked), poses out.
+#include "soft_body_sim/ros/ros_converter.h"
+
+namespace soft_body_sim
+{
+geometry_msgs::Pose RosConverter::toPose(const Vec3& position)
+{
+  geometry_msgs::Pose pose;
+  pose.position.x = position.x();
+  pose.position.y = position.y();
+  pose.position.z = position.z();
+  pose.orientation.w = 1.0;
+  return pose;
+}
+
+bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why)
+{
+  const Vec3 p = toVec3(pose.position);
+  const Eigen::Vector4d q(pose.orientation.x, pose.orientation.y, pose.orientation.z, pose.orientation.w);
+  if (!p.allFinite())
+  {
+    why = "position is not finite";
+    return false;
+  }
+  if (!q.allFinite())
+  {
+    why = "orientation is not finite";
+    return false;
+  }
+  position = p;
+  return true;
+}
+
+bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position,
+                            std::optional<Eigen::Quaterniond>& orientation, std::string& why)
+{
+  if (!fromPose(pose, position, why))
+    return false;
+  const Eigen::Quaterniond q(pose.orientation.w, pose.orientation.x, pose.orientation.y, pose.orientation.z);
+  orientation.reset();
+  if (q.norm() > 1e-12)
+    orientation = q.normalized();
+  return true;
+}
+
+std::optional<RigidPose> RosConverter::toRigidPose(const geometry_msgs::Transform& transform)
+{
+  RigidPose pose;
+  pose.position = toVec3(transform.translation);
+  pose.orientation = Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y,
+                                        transform.rotation.z);
+  if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite() || !(pose.orientation.norm() > 1e-12))
+    return std::nullopt;
+  pose.orientation.normalize();
+  return pose;
+}
+
+}  // namespace soft_body_sim
