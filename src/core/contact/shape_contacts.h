@@ -101,8 +101,7 @@ public:
   bool resolve(const Model& model, const NodeArray& start, State& state, double h) override
   {
     move(h);
-    // A node resting on a shape approaches it by ~|g| h per sub-step; twice that does not bounce.
-    const double resting_speed = 2.0 * model.gravity.norm() * h;
+    const double resting_speed = restingSpeed(model.gravity, h);
     bool touched_any = false;
     for (int i = 0; i < model.nodeCount(); ++i)
     {
