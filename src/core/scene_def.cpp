@@ -136,6 +136,9 @@ World buildWorld(const SceneDef& scene)
   int first = 0;
   for (const BodyDef& body : scene.bodies)
   {
+    // A generated body's builder (buildRope, buildJelly, ...) checked its definition, at the keys that set
+    // it (a rope's `radius`, a jelly's `pressure`); a custom body is its own definition, checked here.
+    const bool custom = body.type == "custom";
     const int count = static_cast<int>(body.nodes.size());
     for (int k = 0; k < count; ++k)
     {
@@ -168,7 +171,7 @@ World buildWorld(const SceneDef& scene)
       cell.normal = c.normal.normalized();
       cell.pressure = c.pressure;
       cell.rest_area = c.rest_area ? *c.rest_area : cellArea(cell, state.position);
-      if (!(cell.rest_area > 0.0) || !(cell.pressure > 0.0))
+      if (!(cell.rest_area > 0.0) || (custom && !(cell.pressure > 0.0)))
         throw std::invalid_argument("body '" + body.name + "': a cell needs a positive rest area (its nodes "
                                     "counter-clockwise about its normal) and a positive pressure");
       model.cells.push_back(cell);
@@ -210,9 +213,7 @@ World buildWorld(const SceneDef& scene)
     }
     if (body.controller)
       controllers.push_back({ static_cast<int>(model.bodies.size()), body.controller(first) });
-    // A solid's self_friction is its surface's friction against other bodies (surface_contacts.h), its
-    // builder's check; it has no self-collision.
-    if (body.tetrahedra.empty())
+    if (custom)
       requireSelfContact("body '" + body.name + "'", body.self_collision, body.self_friction, body.contact_radius,
                          "contact_radius");
     model.bodies.push_back(

@@ -292,8 +292,7 @@ bool World::detach(int anchor)
   const int node = model_.anchors[k].node;
   if (const StationIndex at = findRodStation(model_, node))
     releaseRod(model_.rods[static_cast<std::size_t>(at.rod)], state_.position, state_.twist, at.station);
-  // A node of a frozen body stays pinned: the guard froze it there.
-  model_.inverse_mass[node] = guard_.isFrozen(model_.bodyOf(node)) ? 0.0 : 1.0 / model_.mass[node];
+  model_.releaseNode(node, guard_.isFrozen(model_.bodyOf(node)));
   model_.anchors.erase(model_.anchors.begin() + anchor);
   anchors_.removed(k);
   modelChanged();

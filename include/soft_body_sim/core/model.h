@@ -166,6 +166,9 @@ struct Model
 
   int nodeCount() const { return static_cast<int>(mass.size()); }
   bool isFree(int i) const { return inverse_mass[i] > 0.0; }
+  /// A holder (an attached anchor, a grasp) lets node `node` go: it is free again, inverse mass 1 / mass,
+  /// unless its body is `frozen` (the divergence guard pinned it there, and there it stays).
+  void releaseNode(int node, bool frozen) { inverse_mass[node] = frozen ? 0.0 : 1.0 / mass[node]; }
   /// Index into `bodies` of the body holding node `node`; throws std::out_of_range if none does.
   std::size_t bodyOf(int node) const
   {

@@ -71,6 +71,8 @@ struct AnchorDef
 struct BodyDef
 {
   std::string name;
+  /// "custom": the body is its own definition, which buildWorld checks; else the body type whose builder
+  /// (buildRope, ...) made it from a definition of its own and checked that.
   std::string type = "custom";
   std::vector<NodeDef> nodes;
   std::vector<SpringDef> springs;
@@ -102,9 +104,9 @@ struct BodyDef
   std::vector<std::array<int, 3>> surface;
 };
 
-/// The checks of a body type's self-contact keys (rope, cloth, jelly), for its builder: self_friction
-/// >= 0 and only with self_collision, and self_collision only with a contact radius > 0 (the key
-/// `radius_key`). Throws DefinitionError naming the keys.
+/// The checks of a body's self-contact keys, for the builder of its type (rope, rod, cloth, jelly) or, for a
+/// custom body, buildWorld: self_friction >= 0 and only with self_collision, and self_collision only with a
+/// contact radius > 0 (the key `radius_key`). Throws DefinitionError naming the keys.
 void requireSelfContact(const std::string& what, bool self_collision, double self_friction, double contact_radius,
                         const std::string& radius_key);
 
@@ -170,10 +172,12 @@ constexpr double kUnsupportedFall = 2.0;
 std::optional<TunnellingRisk> tunnellingRisk(const SceneDef& scene, const StepSettings& step);
 
 /// Flattens the bodies into one node array (body k's nodes follow body k-1's), pins anchored nodes,
-/// makes the controllers and returns the world. Expects a valid scene (the loader checks); throws
-/// std::invalid_argument on an index out of range, a bad collider (a zero plane normal), a zero cell
-/// normal, or a cell whose rest area is not positive. With `dt: auto` it also takes the sub-steps that
-/// the rule against passing through needs (tunnellingRisk); a fixed step is the loader's to check.
+/// makes the controllers and returns the world. Expects a valid scene (the loader checks, and each
+/// generated body's builder); throws std::invalid_argument on an index out of range, a bad collider (a zero
+/// plane normal), a zero cell normal, a cell whose rest area is not positive and, in a custom body, a cell
+/// whose pressure is not positive or self-contact keys that requireSelfContact refuses. With `dt: auto` it
+/// also takes the sub-steps that the rule against passing through needs (tunnellingRisk); a fixed step is
+/// the loader's to check.
 World buildWorld(const SceneDef& scene);
 
 }  // namespace soft_body_sim

@@ -16,6 +16,11 @@ struct ContactSurface
   double restitution = 0.0;  ///< [0, 1]
 };
 
+/// The approach speed [m/s] at or below which a node's contact is no impact (it does not bounce), for
+/// gravity `gravity` [m/s^2] and a sub-step of h [s]: a node resting on a surface approaches it by ~|g| h
+/// per sub-step; twice that does not bounce.
+inline double restingSpeed(const Vec3& gravity, double h) { return 2.0 * gravity.norm() * h; }
+
 /// A node `depth` [m] (> 0) behind `surface` after a sub-step of h [s] that moved it by `displacement`
 /// [m]: it moves out along the normal and, if it was approaching the surface, loses its approach speed
 /// (bouncing with the restitution on an `impact`), and Coulomb friction acts relative to the surface at

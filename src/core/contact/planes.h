@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/contact/contact_response.h"
 #include "soft_body_sim/core/contact/contact_stage.h"
 #include "soft_body_sim/core/model.h"
 
@@ -14,8 +15,9 @@ namespace soft_body_sim
 /// contact_response.h) and, on a new impact, bounces it with the plane's restitution. A plane is a
 /// half-space, so a fast node cannot tunnel through it.
 /// An impact is new when the node did not touch any plane in the previous sub-step (`touching`, one
-/// flag per node, updated here) and approaches faster than `resting_speed` [m/s]: a node resting on a
-/// floor, alone or under the weight of others, gains approach speed every step and must not jitter.
+/// flag per node, updated here) and approaches faster than `resting_speed` [m/s] (restingSpeed,
+/// contact_response.h): a node resting on a floor, alone or under the weight of others, gains approach
+/// speed every step and must not jitter.
 /// Returns true if any node was touched.
 /// `planes` have unit normals; h [s] is the sub-step just taken, which started at `start` [m].
 bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, const NodeArray& start, State& state,
@@ -28,10 +30,9 @@ public:
   /// Keeps the planes with unit normals; throws std::invalid_argument on a zero normal.
   PlaneContacts(std::vector<Plane> planes, int nodes);
 
-  /// A node resting on a plane approaches it by ~|g| h per sub-step; twice that does not bounce.
   bool resolve(const Model& model, const NodeArray& start, State& state, double h) override
   {
-    return collideWithPlanes(planes_, model, start, state, 2.0 * model.gravity.norm() * h, touching_, h);
+    return collideWithPlanes(planes_, model, start, state, restingSpeed(model.gravity, h), touching_, h);
   }
 
   bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const override

@@ -5,65 +5,22 @@
 #include <cstdlib>
 #include <tuple>
 
+#include "core/contact/closest_points.h"
+
 namespace soft_body_sim
 {
 namespace
 {
-/// The parameters s, t in [0, 1] of the nearest points of segments p0 + s d1 and q0 + t d2 (Ericson,
-/// Real-Time Collision Detection, 5.1.9), or of the nearest among their ends and the other segment if
-/// the two are within ~10 degrees of parallel. A link lying along another (a rope in a groove, on a rope)
-/// then meets it at one of its nodes, each node pushed out by its own depth: a point inside the link
-/// (where the nearly parallel lines come closest, ill-conditioned) would push both nodes by the depth
-/// there, throwing out one that a neighbouring link had already freed, and that node, off the surface,
-/// would slip with no friction holding it.
-std::pair<double, double> contactParameters(const Vec3& p0, const Vec3& d1, const Vec3& q0, const Vec3& d2)
-{
-  const Vec3 r = p0 - q0;
-  const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  if (!(a > 0.0) && !(e > 0.0))
-    return { 0.0, 0.0 };
-  if (!(a > 0.0))
-    return { 0.0, std::clamp(f / e, 0.0, 1.0) };
-  const double c = d1.dot(r);
-  if (!(e > 0.0))
-    return { std::clamp(-c / a, 0.0, 1.0), 0.0 };
-  const double b = d1.dot(d2), denominator = a * e - b * b;
-  if (denominator < 0.03 * a * e)  // sin^2 of the angle between them < 0.03
-  {
-    const std::pair<double, double> ends[4] = { { 0.0, std::clamp(f / e, 0.0, 1.0) },
-                                                { 1.0, std::clamp((b + f) / e, 0.0, 1.0) },
-                                                { std::clamp(-c / a, 0.0, 1.0), 0.0 },
-                                                { std::clamp((b - c) / a, 0.0, 1.0), 1.0 } };
-    std::pair<double, double> nearest = ends[0];
-    double least = 1e300;
-    for (const auto& [s, t] : ends)
-    {
-      const double gap = (r + s * d1 - t * d2).squaredNorm();
-      if (gap < least)
-      {
-        least = gap;
-        nearest = { s, t };
-      }
-    }
-    return nearest;
-  }
-  double s = std::clamp((b * f - c * e) / denominator, 0.0, 1.0);
-  double t = (b * s + f) / e;
-  if (t < 0.0)
-  {
-    t = 0.0;
-    s = std::clamp(-c / a, 0.0, 1.0);
-  }
-  else if (t > 1.0)
-  {
-    t = 1.0;
-    s = std::clamp((b - c) / a, 0.0, 1.0);
-  }
-  return { s, t };
-}
+/// Two links within ~10 degrees of parallel (sin^2 of the angle between them below this) meet at the
+/// nearest of their ends to the other link (closestSegmentParameters). A link lying along another (a rope
+/// in a groove, on a rope) then meets it at one of its nodes, each node pushed out by its own depth: a
+/// point inside the link (where the nearly parallel lines come closest, ill-conditioned) would push both
+/// nodes by the depth there, throwing out one that a neighbouring link had already freed, and that node,
+/// off the surface, would slip with no friction holding it.
+constexpr double kParallelSine2 = 0.03;
 
-/// The vector [m] from the contact point of `to`'s segment to that of `from`'s (contactParameters), and
-/// their parameters p (along `from`) and q (along `to`).
+/// The vector [m] from the contact point of `to`'s segment to that of `from`'s (closestSegmentParameters,
+/// kParallelSine2), and their parameters p (along `from`) and q (along `to`).
 Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::pair<int, int>& to, double& p,
                 double& q)
 {
@@ -75,7 +32,7 @@ Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::
   }
   const Vec3 xa = x.col(from.first), xc = x.col(to.first);
   const Vec3 along_from = x.col(from.second) - xa, along_to = x.col(to.second) - xc;
-  std::tie(p, q) = contactParameters(xa, along_from, xc, along_to);
+  std::tie(p, q) = closestSegmentParameters(xa, along_from, xc, along_to, kParallelSine2);
   return (xa + p * along_from) - (xc + q * along_to);
 }
 

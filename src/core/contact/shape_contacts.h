@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/contact/closest_points.h"
 #include "core/contact/contact_response.h"
 #include "soft_body_sim/core/contact/contact_stage.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
@@ -46,25 +47,10 @@ inline double nearestParameter(const Sphere& /*sphere*/, const Vec3& la, const V
   return length2 > 0.0 ? std::clamp(-la.dot(d) / length2, 0.0, 1.0) : 0.0;
 }
 
-/// A capsule is nearest where its axis is: the closest points of two segments (Ericson, Real-Time
-/// Collision Detection, 5.1.9).
+/// A capsule is nearest where its axis is: the closest points of two segments (closest_points.h).
 inline double nearestParameter(const Capsule& capsule, const Vec3& la, const Vec3& d)
 {
-  const Vec3 q0(0.0, 0.0, -0.5 * capsule.length), axis(0.0, 0.0, capsule.length);
-  const Vec3 r = la - q0;
-  const double a = d.squaredNorm(), e = axis.squaredNorm(), f = axis.dot(r), c = d.dot(r);
-  if (!(a > 0.0))
-    return 0.0;
-  if (!(e > 0.0))
-    return std::clamp(-c / a, 0.0, 1.0);
-  const double b = d.dot(axis), denominator = a * e - b * b;
-  double t = denominator > 0.0 ? std::clamp((b * f - c * e) / denominator, 0.0, 1.0) : 0.0;
-  const double s = (b * t + f) / e;
-  if (s < 0.0)
-    t = std::clamp(-c / a, 0.0, 1.0);
-  else if (s > 1.0)
-    t = std::clamp((b - c) / a, 0.0, 1.0);
-  return t;
+  return closestSegmentParameters(la, d, Vec3(0.0, 0.0, -0.5 * capsule.length), Vec3(0.0, 0.0, capsule.length)).first;
 }
 
 /// A mesh need not be convex, so the distance along a segment may have several minima: it is sampled at
@@ -115,8 +101,7 @@ public:
   bool resolve(const Model& model, const NodeArray& start, State& state, double h) override
   {
     move(h);
-    // A node resting on a shape approaches it by ~|g| h per sub-step; twice that does not bounce.
-    const double resting_speed = 2.0 * model.gravity.norm() * h;
+    const double resting_speed = restingSpeed(model.gravity, h);
     bool touched_any = false;
     for (int i = 0; i < model.nodeCount(); ++i)
     {

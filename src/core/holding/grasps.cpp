@@ -78,7 +78,7 @@ bool GraspSet::release(Model& model, State& state, const std::string& name, bool
     releaseRod(model.rods[static_cast<std::size_t>(at.rod)], state.position, state.twist, at.station);
   }
   for (const int node : grasps_[k].nodes)
-    model.inverse_mass[node] = frozen ? 0.0 : 1.0 / model.mass[node];
+    model.releaseNode(node, frozen);
   const auto at = static_cast<std::ptrdiff_t>(k);
   grasps_.erase(grasps_.begin() + at);
   goals_.erase(goals_.begin() + at);

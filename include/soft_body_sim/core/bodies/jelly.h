@@ -11,7 +11,7 @@
 //     self_collision its nodes stay out of its springs (self_contacts.h).
 //  2. jitter at the walls: the seed reverses a node's velocity at every contact, so the weight of the
 //     structure drives the bottom nodes to vibrate. Plane contacts here remove the normal approach
-//     and do not bounce below a resting speed (planes.h). A jelly's floor should have restitution
+//     and do not bounce below a resting speed (restingSpeed). A jelly's floor should have restitution
 //     0: the jelly bounces by its own elasticity, and the resting speed (2 g h) only covers a node's own
 //     weight, so with restitution > 0 floor nodes carrying the jelly above them would be bounced
 //     (in velocity, not in position) at every step.
