@@ -103,20 +103,20 @@ public:
   /// std::invalid_argument on a bad value and keeps the old settings.
   void setStepSettings(const StepSettings& settings);
   /// Switches the integrator of every body; the new one starts from the current positions and velocities.
-  /// Throws std::invalid_argument (and keeps the old one) if the scene has a rod and `type` is not
-  /// implicit_euler, the only integrator that bends and twists rods.
+  /// Throws std::invalid_argument (and keeps the old one) if `type` does not run every element kind of the
+  /// scene (a rod or a soft solid runs only under implicit_euler: requireIntegratorRunsModel).
   void setIntegrator(IntegratorType type);
   /// [m/s^2], finite; throws std::invalid_argument otherwise.
   void setGravity(const Vec3& gravity);
   /// Linear air drag [1/s], finite and >= 0; throws std::invalid_argument otherwise.
   void setDrag(double drag);
-  /// Scales body `body`'s springs, constraints and cells from the values it was built with; false if
+  /// Scales body `body`'s elements (every kind's, MaterialScaling) from the values it was built with; false if
   /// there is no such body. Throws std::invalid_argument if a factor is out of range (see BodyScaling).
   bool setBodyScaling(const std::string& body, const BodyScaling& scaling);
   /// The scaling last set for `body` (all 1 if never set or unknown).
   BodyScaling bodyScaling(const std::string& body) const;
-  /// True if body `body` (index into model().bodies) has a material to scale: springs, constraints or
-  /// cells (a humanoid, all kinematic nodes, has none).
+  /// True if body `body` (index into model().bodies) has a material to scale: elements of any kind (a
+  /// humanoid, all kinematic nodes, has none).
   bool hasMaterial(std::size_t body) const { return material_.has(body); }
 
   // --- anchors that follow a path, and grasping -----------------------------------------------------

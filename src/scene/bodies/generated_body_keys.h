@@ -1,5 +1,5 @@
-// Keys shared by the readers of the generated mass-spring bodies (rope, cloth, jelly): node counts,
-// spring families, grid corners, pinned nodes and self-contact. Private to those readers.
+// Keys shared by the readers of the generated bodies (rope, rod, cloth, jelly): node counts, spring
+// families, grid corners, pinned nodes and self-contact. Private to those readers.
 #pragma once
 
 #include <string>

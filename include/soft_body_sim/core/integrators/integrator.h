@@ -1,5 +1,6 @@
-// Time integrators. Each advances the same physical model (springs, dashpots, gravity, drag,
-// distance constraints) by one (sub)step h, so that their results can be compared.
+// Time integrators. Each advances a model by one (sub)step h: every one steps springs, dashpots, gas cells,
+// gravity, drag and distance constraints, so that their results can be compared; rods and soft solids run
+// only under implicit_euler (each element kind says which integrators run it: element_kinds.h).
 #pragma once
 
 #include <memory>
