@@ -99,7 +99,6 @@ struct Rod
   Vec3 end_moment = Vec3::Zero();
 
   int last() const { return first + count - 1; }
-  double restLength() const { return segment_length * (count - 1); }
 };
 
 /// A tetrahedron of a soft solid (a `type: volume` body; tetrahedra.h): four nodes, positively oriented at

@@ -88,11 +88,9 @@ public:
   /// The current pose of every placed drawable collider, by kind (spheres, capsules, boxes, cylinders,
   /// meshes), each kind in declaration order.
   std::vector<ColliderPose> colliderPoses() const { return contacts_.poses(); }
-  /// Moves collider `name` to `pose` during the next step at constant linear and angular velocity (which
-  /// friction sees), as moveAnchor; false if there is none of that name. The latest call before a step wins.
-  bool moveCollider(const std::string& name, const RigidPose& pose) { return contacts_.setGoal(name, pose, settings_.dt); }
-  /// Every step, collider `name` moves (as by moveCollider) to path(t) at the step's end time t; where the
-  /// path has no pose it holds still. False if there is none of that name.
+  /// Every step, collider `name` moves to path(t) at the step's end time t, at constant linear and angular
+  /// velocity over the step (which friction sees); where the path has no pose it holds still. False if there
+  /// is none of that name.
   bool followColliderPath(const std::string& name, ColliderPath path) { return contacts_.followPath(name, std::move(path)); }
 
   /// Sets a node's position [m] and velocity [m/s] directly.

@@ -24,7 +24,8 @@ struct Plane
 };
 
 /// Where a rigid collider is and how it moves, and its surface. Its pose moves at constant `velocity`
-/// and `angular_velocity` (about its own origin) unless the caller sets it (a tf frame, World::moveCollider).
+/// and `angular_velocity` (about its own origin) unless the caller sets it (a tf frame,
+/// World::followColliderPath).
 struct ColliderPlacement
 {
   std::string name;

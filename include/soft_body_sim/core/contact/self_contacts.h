@@ -79,9 +79,6 @@ public:
   /// `rest`: the nodes' positions [m] at rest (the scene's start), which tell a cloth's neighbours apart.
   SelfContacts(const Model& model, const NodeArray& rest);
 
-  /// True if no body asks for self-collision: resolve() does nothing.
-  bool empty() const { return segments_.empty(); }
-
   /// At the start of a sub-step (before anchors move): where the links start, from which friction
   /// measures their slip. Nothing without friction.
   void remember(const State& state);

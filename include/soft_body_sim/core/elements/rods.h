@@ -80,7 +80,7 @@ inline const RodStation& rodStation(const Model& model, StationIndex at)
 inline Vec3 stationAxis(const Rod& rod, int s, int side) { return rod.stations[static_cast<std::size_t>(s)].frame[side] * Vec3::UnitX(); }
 
 /// The twist interval after station s (to station s + 1): its length [m] between the two stations' nearest
-/// nodes (Rod::restLength between two held ends), and its slot in State::twist (station s's last node).
+/// nodes (segment_length per segment between them), and its slot in State::twist (station s's last node).
 double intervalLength(const Rod& rod, int s);
 inline int twistSlot(const Rod& rod, int s) { return rod.stations[static_cast<std::size_t>(s)].last; }
 
