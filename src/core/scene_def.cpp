@@ -217,7 +217,8 @@ World buildWorld(const SceneDef& scene)
       requireSelfContact("body '" + body.name + "'", body.self_collision, body.self_friction, body.contact_radius,
                          "contact_radius");
     model.bodies.push_back(
-        { body.name, first, count, body.self_collision, body.self_friction, body.springs_collide, std::move(surface) });
+        { body.name, first, count, body.self_collision, body.self_friction, body.springs_collide, std::move(surface),
+          body.surface_friction });
     first += count;
   }
   try

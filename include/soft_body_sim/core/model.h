@@ -121,13 +121,16 @@ struct BodyRange
   int first = 0;
   int count = 0;
   bool self_collision = false;  ///< its links keep apart by their radii (self_contacts.h)
-  /// Coulomb coefficient [-] where they touch (self_contacts.h); a solid's: its surface's against other
-  /// bodies (surface_contacts.h)
+  /// Coulomb coefficient [-] where its links touch each other or another self-colliding body's
+  /// (self_contacts.h)
   double self_friction = 0.0;
   bool springs_collide = false; ///< its springs too keep its own nodes out (a jelly; self_contacts.h)
   /// A solid's boundary (a `type: volume` body): triangles of global node indices, counter-clockwise seen
   /// from outside; empty for every other body.
   std::vector<std::array<int, 3>> surface;
+  /// A solid's Coulomb coefficient [-] against the other bodies' nodes on its surface (surface_contacts.h;
+  /// two solids use the mean of theirs); 0 for every other body.
+  double surface_friction = 0.0;
 };
 
 /// A named node of a body that the caller moves kinematically (its node is pinned).

@@ -102,6 +102,9 @@ struct BodyDef
   /// A solid's boundary triangles, node indices within the body, counter-clockwise seen from outside
   /// (BodyRange::surface).
   std::vector<std::array<int, 3>> surface;
+  /// A solid's Coulomb coefficient [-] >= 0 against the other bodies' nodes on its surface
+  /// (BodyRange::surface_friction; a volume's `friction`).
+  double surface_friction = 0.0;
 };
 
 /// The checks of a body's self-contact keys, for the builder of its type (rope, rod, cloth, jelly) or, for a

@@ -124,7 +124,7 @@ BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
   body.name = name;
   body.type = "volume";
   body.contact_radius = 0.0;  // its nodes are its contact points
-  body.self_friction = volume.friction;  // its surface's, against other bodies (surface_contacts.h)
+  body.surface_friction = volume.friction;
   for (const Eigen::Vector3d& node : mesh.nodes)
     body.nodes.push_back(NodeDef{ node + volume.position, 0.0, Vec3::Zero(), false });
 

@@ -81,7 +81,7 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
         continue;
       const BodyRange& body = model.bodies[other];
       const double friction =
-          body.surface.empty() ? solid.self_friction : 0.5 * (solid.self_friction + body.self_friction);
+          body.surface.empty() ? solid.surface_friction : 0.5 * (solid.surface_friction + body.surface_friction);
       for (int p = body.first; p < body.first + body.count; ++p)
       {
         const Vec3 at = x.col(p);
