@@ -26,6 +26,9 @@ Parameters (private, all optional):
   ~rate           [Hz] poses per second on each topic (default 20)
   ~lead           [s] each pose is stamped this far ahead of now, so that it reaches the simulator
                   before its step and a replay of the recording is exact (default 0.1)
+  ~wait_for       node names (e.g. [/soft_body_sim, /record_soft_body_sim]) that must be connected to
+                  every topic above before the first pose goes out (default []): what a recorder
+                  missed while it subscribed would be missing from its bag, and a replay would differ
 """
 import math
 
@@ -71,6 +74,16 @@ def transform(frame_id, child, stamp, x, y, z):
     return message
 
 
+def wait_for_connections(publishers, nodes):
+    """Returns once each of `nodes` (names) is connected to each of `publishers`; says whom it waits for."""
+    def missing():
+        return sorted({node for node in nodes for p in publishers if not p.impl.has_connection(node)})
+    if missing():
+        rospy.loginfo("send_targets: waiting for %s to subscribe", ", ".join(missing()))
+    while missing() and not rospy.is_shutdown():
+        rospy.sleep(0.01)
+
+
 def main():
     rospy.init_node("send_targets")
     frame_id = rospy.get_param("~frame_id", "world")
@@ -95,6 +108,8 @@ def main():
     broadcaster = tf2_ros.TransformBroadcaster() if gripper_frame else None
     while rospy.Time.now().is_zero() and not rospy.is_shutdown():  # /use_sim_time: wait for /clock
         rospy.sleep(0.01)
+    publishers = [p for p in (target_pub, anchor_pub, broadcaster.pub_tf if broadcaster else None) if p]
+    wait_for_connections(publishers, rospy.get_param("~wait_for", []))
     start = rospy.Time.now()
     ticker = rospy.Rate(rate)
     while not rospy.is_shutdown():

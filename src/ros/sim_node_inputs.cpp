@@ -151,6 +151,11 @@ void SimNode::schedule(const std::string& topic, const ros::Time& stamp, const S
   switch (admission.verdict)
   {
     case InputSchedule::Verdict::Held:
+      if (!stamp.isZero() && started_ && stamp < rosTime(world_->time()))
+        ROS_WARN_THROTTLE(5.0,
+                          "%s: input late: stamped %.3g s before the simulated instant, so it takes effect at the "
+                          "next step, and a replay (which has it in time) differs; stamp inputs ahead of now",
+                          topic.c_str(), (rosTime(world_->time()) - stamp).toSec());
       break;
     case InputSchedule::Verdict::Stale:
       ROS_WARN_THROTTLE(5.0, "%s: input dropped: stamped %.3f s behind the ROS clock, more than ~max_input_age = %g s",
@@ -282,7 +287,12 @@ std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros:
     }
     catch (const tf2::ExtrapolationException&)
     {
+      // Past the latest transform (still on its way): the latest. Before the earliest, the frame did not
+      // exist yet at `stamp`: none, as when tf has nothing. Not the latest either: which transforms a
+      // catch-up step finds in the buffer depends on when its tick runs, so a replay would see another one.
       transform = tf_buffer_.lookupTransform(scene_.frame_id, frame, ros::Time(0));
+      if (transform.header.stamp >= stamp)
+        throw tf2::LookupException("its first transform is stamped after this step");
     }
   }
   catch (const tf2::TransformException& e)

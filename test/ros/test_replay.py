@@ -1,24 +1,27 @@
 #!/usr/bin/python3
-"""Determinism through rosbag (launched by replay.test, which starts only the master):
+"""Determinism through rosbag, on the demo as the README tells it (launched by replay.test, which starts
+only the master):
 
-1. record: record.launch, then sim.launch on replay_test_scene.yaml in wall-clock time, whose rope end
-   the test drives along a path with poses stamped ahead (as send_targets.py does);
-2. replay: a fresh sim.launch under /use_sim_time, told the recorded start time (start_time:=, from the
-   bag's ~start_time topic), fed only the bag's input topic by `rosbag play --clock`;
-3. every state published by both at the same simulated instant must be bit-identical: same inputs at
-   the same steps, same build, same arithmetic.
+1. record: demo.launch rviz:=false record:=<folder>/run: send_targets.py streams the rope's right end,
+   the codeling's target and the gripper's tf frame once the simulator and the recorder listen. Under a
+   /clock that the test runs at half speed, not wall-clock time: on a shared machine the demo, at a
+   real-time factor near 1, may fall behind real time now and then, and such a bag is not replayable
+   (bag_start_time.py says so); a clock it always keeps up with records what a fast machine records;
+2. replay: a fresh sim.launch on the demo scene under /use_sim_time, told the recorded start time (from
+   the bag's ~start_time), fed only the bag's input topics and /tf by `rosbag play --clock`;
+3. every state published by both at the same simulated instant must be bit-identical in every body:
+   same inputs at the same steps, same build, same arithmetic.
 
-Every step waits for what the next one needs (a node registered, a topic subscribed, a state past an
+Every step waits for what the next one needs (a topic subscribed, a state past an
 instant) rather than for a fixed time, within STARTUP seconds: on a loaded machine roslaunch alone can
-take several seconds. The nodes are started with roslaunch, not rosrun: rosrun leaves out every path
-under <package>/build/, so it cannot find the node of a devel space built inside the package (build/)."""
+take several seconds."""
 import glob
-import math
 import os
 import shutil
 import signal
 import subprocess
 import tempfile
+import threading
 import time
 
 import rosbag
@@ -26,19 +29,39 @@ import rosgraph
 import rospy
 import rostest
 from geometry_msgs.msg import PoseStamped
+from rosgraph_msgs.msg import Clock
 
 from node_client import NodeTestCase, StateWatcher, wait_for
 
-SCENE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "replay_test_scene.yaml")
 NODE = "/soft_body_sim"
-INPUT = NODE + "/rope/end/pose"
+INPUTS = [NODE + "/rope/right/pose", NODE + "/codeling/target"]
 STATE = NODE + "/state"
 START_TIME = NODE + "/start_time"
-RECORDER = "/record_soft_body_sim"
+BAG_START_TIME = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts", "bag_start_time.py")
 STARTUP = 60.0  # [s] bound on any one wait for a process to come up, subscribe or catch up
-# [s] how far ahead the poses are stamped: an input must reach the node (and, for the replay, the
-# recorder) before its step, whatever the load; send_targets.py's 0.1 s is meant for an idle machine.
-LEAD = 0.5
+RUN = 8.0  # [s] of the recorded demo from its first input: the gripper's fingers reach the rope by then
+RATE = 0.5  # of the recording's clock and rosbag play's: ROS seconds per wall second
+
+
+class HalfSpeedClock:
+    """Publishes /clock from a plausible ROS time on, RATE times as fast as wall time, every 2 ms."""
+
+    def __init__(self):
+        self.publisher = rospy.Publisher("/clock", Clock, queue_size=10)
+        self.running = True
+        self.thread = threading.Thread(target=self.run, daemon=True)
+        self.thread.start()
+
+    def run(self):
+        origin, begin = time.time(), time.monotonic()
+        while self.running:
+            self.publisher.publish(Clock(rospy.Time.from_sec(origin + RATE * (time.monotonic() - begin))))
+            time.sleep(0.002)
+
+    def stop(self):
+        self.running = False
+        self.thread.join()
+        self.publisher.unregister()
 
 
 def start(log, *command):
@@ -58,21 +81,14 @@ def subscriptions(node):
     return {topic for topic, nodes in subscribers if node in nodes}
 
 
-def registered(node):
-    try:
-        rosgraph.Master(rospy.get_name()).lookupNode(node)
-        return True
-    except rosgraph.MasterError:
-        return False
-
-
 def key(state):
     return state.header.stamp.to_nsec()
 
 
 def values(state):
-    """Every number of the state's bodies, exactly as sent."""
-    return [(p.x, p.y, p.z, v.x, v.y, v.z) for body in state.bodies for p, v in zip(body.positions, body.velocities)]
+    """Every number of each body (by name), exactly as sent."""
+    return {body.name: [(p.x, p.y, p.z, v.x, v.y, v.z) for p, v in zip(body.positions, body.velocities)]
+            for body in state.bodies}
 
 
 class ReplayTest(NodeTestCase):
@@ -124,85 +140,73 @@ class ReplayTest(NodeTestCase):
 
     def record_and_replay(self):
         watcher = StateWatcher()
+        first_input = []
+        rospy.Subscriber(INPUTS[0], PoseStamped, lambda pose: first_input or first_input.append(pose.header.stamp))
 
-        # --- 1. record a live run
-        self.launch("recorder", "roslaunch", "soft_body_sim", "record.launch", f"bag:={self.folder}/run")
-        self.wait(lambda: registered(RECORDER), "recorder")
-        self.launch("recorded_node", "roslaunch", "soft_body_sim", "sim.launch", f"scene:={SCENE}")
-        self.wait(lambda: watcher.latest is not None, "state of the recorded node")
-        # rosbag record subscribes to each matching topic once it sees it at the master: the inputs may
-        # go out once it and the node listen to them, and it has the state and the start time.
-        self.wait(lambda: {INPUT, STATE, START_TIME} <= subscriptions(RECORDER) and INPUT in subscriptions(NODE),
-                  "subscription of the recorder and the node to the inputs")
-        publisher = rospy.Publisher(INPUT, PoseStamped, queue_size=100)
-        self.wait(lambda: publisher.get_num_connections() >= 2, "connection of the node and the recorder")
-        ticker = rospy.Rate(25)
-        begin = time.monotonic()
-        last_stamp = None
-        while time.monotonic() - begin < 3.0:
-            pose = PoseStamped()
-            pose.header.frame_id = "world"
-            pose.header.stamp = last_stamp = rospy.Time.now() + rospy.Duration(LEAD)
-            phase = 2.0 * (time.monotonic() - begin)
-            pose.pose.position.x = 0.4 + 0.2 * math.sin(phase)
-            pose.pose.position.z = 1.0 + 0.2 * (1.0 - math.cos(phase))
-            pose.pose.orientation.w = 1.0
-            publisher.publish(pose)
-            ticker.sleep()
-        # Every input has taken effect once the node has simulated past the last one's stamp.
-        self.wait(lambda: watcher.latest.header.stamp > last_stamp + rospy.Duration(0.1), "state past the last input")
-        self.finish("recorded_node")
-        self.finish("recorder")
+        # --- 1. record the demo, from its first input
+        rospy.set_param("/use_sim_time", True)  # for the nodes to come; this test's node keeps wall time
+        clock = HalfSpeedClock()
+        self.launch("demo", "roslaunch", "soft_body_sim", "demo.launch", "rviz:=false", f"record:={self.folder}/run")
+        self.wait(lambda: first_input, "the first input of send_targets.py")
+        self.wait(lambda: watcher.latest is not None and watcher.latest.header.stamp > first_input[0] + rospy.Duration(RUN),
+                  f"state {RUN} s past the first input")
+        self.finish("demo")
+        clock.stop()
         bags = glob.glob(os.path.join(self.folder, "run_*.bag"))
         self.assertEqual(len(bags), 1, os.listdir(self.folder))
-        recorded, start_times, inputs, late, topics, last_input_time = {}, set(), 0, 0, set(), None
+        # The start time to replay from, as the README has the user find it (the last one: it may move while
+        # the demo starts up, not after the first input).
+        found = subprocess.run([BAG_START_TIME, bags[0]], capture_output=True, text=True)
+        self.assertEqual(found.returncode, 0, found.stderr)
+        start_time = rospy.Time(*map(int, found.stdout.strip().split(".")))
+        start_time.nsecs *= 1000000
+        recorded, inputs, late, topics, last_input_time, first_recorded = {}, 0, 0, set(), None, {}
         with rosbag.Bag(bags[0]) as bag:
             for topic, message, received in bag.read_messages():
                 topics.add(topic)
                 if topic == STATE:
                     recorded[key(message)] = values(message)
                 elif topic == START_TIME:
-                    start_times.add(message.data)
-                elif topic == INPUT:
+                    recorded.clear()  # the states before it are stamped from an earlier start time
+                elif topic in INPUTS or topic == "/tf":
+                    stamps = [message.header.stamp] if topic in INPUTS else [t.header.stamp for t in message.transforms]
+                    first_recorded.setdefault(topic, min(stamps))
                     inputs += 1
-                    late += message.header.stamp <= received
+                    late += sum(stamp <= received for stamp in stamps)
                     last_input_time = received
-        # record.launch took inputs, markers, state and the start time.
-        self.assertTrue({INPUT, NODE + "/markers", STATE, START_TIME} <= topics, topics)
-        self.assertGreater(inputs, 50)
-        self.assertEqual(len(start_times), 1, "the recorded node fell behind real time (its start time moved): such "
-                         f"a recording is not replayable exactly; start times {sorted(start_times)}")
-        start_time = start_times.pop()
-        self.assertEqual(start_time.nsecs % 1000000, 0)  # a whole millisecond: exact as a double parameter
+        self.assertTrue(set(INPUTS) | {"/tf", NODE + "/markers", STATE, START_TIME} <= topics, topics)
+        # The bag holds every input from the first one the simulator heard (the test may have heard later).
+        self.assertLessEqual(first_recorded[INPUTS[0]], first_input[0])
+        self.assertGreater(inputs, 3 * 20 * RUN * 0.9)  # three streams at 20 Hz
         # An input played back after its stamp would reach the replaying node late, at another step.
-        self.assertEqual(late, 0, f"{late} of {inputs} inputs reached the recorder after their stamp")
-        end_x = [state[4][0] for state in recorded.values()]
-        self.assertGreater(max(end_x) - min(end_x), 0.2)  # the inputs moved the rope
+        self.assertEqual(late, 0, f"{late} inputs reached the recorder after their stamp")
 
         # --- 2. replay the inputs into a fresh node under simulated time
         watcher.states.clear()
-        rospy.set_param("/use_sim_time", True)
-        self.launch("replay_node", "roslaunch", "soft_body_sim", "sim.launch", f"scene:={SCENE}",
+        self.launch("replay_node", "roslaunch", "soft_body_sim", "sim.launch",
                     "start_time:=%d.%03d" % (start_time.secs, start_time.nsecs // 1000000))
         # Its time stands at 0 until the first /clock: it must hear the clock and the inputs from the start.
-        self.wait(lambda: {INPUT, "/clock"} <= subscriptions(NODE), "subscription of the replaying node")
-        player = self.launch("player", "rosbag", "play", "--clock", "--wait-for-subscribers", "-q", bags[0],
-                             "--topics", INPUT)
-        self.assertEqual(player.wait(timeout=STARTUP + 10.0), 0)
+        self.wait(lambda: set(INPUTS) | {"/clock", "/tf"} <= subscriptions(NODE), "subscription of the replaying node")
+        player = self.launch("player", "rosbag", "play", "--clock", "--wait-for-subscribers", "-q", "-r", str(RATE),
+                             bags[0], "--topics", *INPUTS, "/tf")
+        self.assertEqual(player.wait(timeout=STARTUP + RUN / RATE), 0)
         self.processes.pop("player")
         # The clock stops at the last input: the node's last tick is at most a tick and a step before it.
         self.wait(lambda: watcher.latest is not None and watcher.latest.header.stamp > last_input_time - rospy.Duration(0.1),
                   "replayed state up to the last input")
 
-        # --- 3. the same instants hold the same numbers
+        # --- 3. the same instants hold the same numbers, in every body
         replayed = {key(state): values(state) for state in watcher.states}
         common = sorted(set(recorded) & set(replayed))
-        self.assertGreater(len(common), 40, f"{len(recorded)} recorded, {len(replayed)} replayed states")
+        self.assertGreater(len(common), 3 * RUN, f"{len(recorded)} recorded, {len(replayed)} replayed states")
         mismatches = [stamp for stamp in common if recorded[stamp] != replayed[stamp]]
         print(f"replay: {len(common)} common instants of {len(recorded)} recorded, {len(replayed)} replayed states; "
               f"{len(mismatches)} differ", flush=True)
-        self.assertEqual(mismatches, [], f"{len(mismatches)} of {len(common)} states differ")
-
+        if mismatches:
+            first = mismatches[0]
+            bodies = [name for name in recorded[first] if recorded[first][name] != replayed[first].get(name)]
+            self.fail(f"{len(mismatches)} of {len(common)} states differ, the first at "
+                      f"{first * 1e-9 - start_time.to_sec():.3f} s in {', '.join(bodies)}")
 
 if __name__ == "__main__":
     rostest.rosrun("soft_body_sim", "replay", ReplayTest)
