@@ -1,5 +1,6 @@
 // SimNode's live tuning (dynamic_reconfigure: ~ for the physics, ~<body> for each body's material) and
 // its health on /diagnostics.
+#include <algorithm>
 #include <cmath>
 
 #include <ros/names.h>
@@ -65,6 +66,8 @@ std::string SimNode::applySimConfig(const SimConfig& config)
   if (settings.dt != world_->settings().dt || settings.substeps != world_->settings().substeps ||
       settings.iterations != world_->settings().iterations)
   {
+    if (integrator == world_->integrator())
+      warnIfSlowerThanRealTime(settings);
     world_->setStepSettings(settings);
     max_steps_per_tick_ = std::max(1L, std::lround(std::ceil(2.0 / (rate_ * settings.dt))));
   }
@@ -76,6 +79,29 @@ std::string SimNode::applySimConfig(const SimConfig& config)
            name_.c_str(), config.integrator.c_str(), config.dt, config.substeps, config.iterations, gravity.x(),
            gravity.y(), gravity.z(), config.drag);
   return "";
+}
+
+void SimNode::warnIfSlowerThanRealTime(const StepSettings& settings) const
+{
+  const StepSettings& now = world_->settings();
+  const double cost = statistics_.wall_seconds_per_step;  // [s] measured at `now`'s settings
+  if (!(cost > 0.0))
+    return;  // nothing measured yet
+  // A lower bound on the new step's cost: every stage runs once per sub-step, so the cost grows at least
+  // with the sub-steps; only some stages repeat per iteration (constraint sweeps, Newton solves), so more
+  // iterations cost more by at most their ratio, and fewer save at most that much. Warned only when even
+  // this bound cannot keep real time: the warning is then certain, whatever the integrator spends where.
+  const double iterations = static_cast<double>(settings.iterations) / now.iterations;
+  const double estimate = cost * settings.substeps / now.substeps * std::min(1.0, iterations);
+  const double factor = settings.dt / estimate;  // simulated seconds per wall second, at most
+  if (factor >= 1.0)
+    return;
+  ROS_WARN("%s: dt = %g s with %d substeps and %d iterations cannot keep real time on this scene: a step "
+           "costs at least %.3g s (measured %.3g s at dt = %g s, %d substeps, %d iterations), a real-time factor of "
+           "at most %.3g; each tick stops stepping after ~tick_budget = %g s and %s",
+           name_.c_str(), settings.dt, settings.substeps, settings.iterations, estimate, cost, now.dt, now.substeps,
+           now.iterations, factor, tick_budget_,
+           ros::Time::isSimTime() ? "the other steps follow later, behind /clock" : "the time left is dropped");
 }
 
 std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& config)

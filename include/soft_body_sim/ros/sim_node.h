@@ -50,8 +50,12 @@ public:
 private:
   // --- time (sim_node.cpp)
   void onTimer(const ros::TimerEvent& event);
-  /// Simulates whole steps up to `now`, at most max_steps_per_tick_ of them (no cap under /use_sim_time).
+  /// Simulates whole steps up to `now`, at most max_steps_per_tick_ of them (no cap under /use_sim_time),
+  /// and none begun after tick_budget_ of wall time: in wall-clock time the steps left are dropped, under
+  /// /use_sim_time they wait for the next tick.
   void advance(const ros::Time& now, double elapsed);
+  /// Warns (throttled) that a tick ran out of tick_budget_ after `taken` of `steps` steps in `wall` [s].
+  void warnOverBudget(long steps, long taken, double wall) const;
   /// The ROS time of the simulated instant world time `t` [s].
   ros::Time rosTime(double t) const { return epoch_ + ros::Duration(t); }
   /// Publishes markers and state stamped with the ROS time of the simulated instant, and the handles.
@@ -101,6 +105,9 @@ private:
   void startReconfigure();
   /// Applies `config` to the world; an empty string, or why it cannot.
   std::string applySimConfig(const SimConfig& config);
+  /// Warns when stepping at `settings` cannot keep real time on this scene, by the measured step cost
+  /// scaled to the new sub-steps and iterations (before the change: the cost measured is the old one).
+  void warnIfSlowerThanRealTime(const StepSettings& settings) const;
   std::string applyBodyConfig(const std::string& body, const BodyConfig& config);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
   /// Logs the divergence guard's catches of the last tick and measures the largest strain.
@@ -120,6 +127,7 @@ private:
   double rate_ = 60.0;          ///< [Hz] of the timer
   double status_period_ = 0.0;  ///< [s] between status lines on the console; 0 = none
   long max_steps_per_tick_ = 1;  ///< catch-up cap: two ticks' worth of steps
+  double tick_budget_ = 0.0;     ///< ~tick_budget [s]: wall time after which a tick begins no further step
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
