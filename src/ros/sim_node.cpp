@@ -45,6 +45,10 @@ void SimNode::initialize()
   if (private_nh_.hasParam("tick_budget") &&
       !(private_nh_.getParam("tick_budget", tick_budget_) && tick_budget_ > 0.0 && std::isfinite(tick_budget_)))
     throw std::runtime_error(private_nh_.resolveName("tick_budget") + ": must be a finite number > 0 [s]");
+  if (private_nh_.hasParam("workspace_radius") &&
+      !(private_nh_.getParam("workspace_radius", workspace_radius_) && workspace_radius_ > 0.0 &&
+        std::isfinite(workspace_radius_)))
+    throw std::runtime_error(private_nh_.resolveName("workspace_radius") + ": must be a finite number > 0 [m]");
   private_nh_.param("status_period", status_period_, 0.0);
   if (private_nh_.getParam("force_scale", force_scale_) && !(force_scale_ > 0.0 && std::isfinite(force_scale_)))
     throw std::runtime_error(private_nh_.resolveName("force_scale") + ": must be a finite number > 0 [m/N]");
@@ -56,6 +60,11 @@ void SimNode::initialize()
     start_time_ = fromMilliseconds(start_time);
   }
   buildWorldFromScene();
+  for (int node = 0; node < world_->model().nodeCount(); ++node)
+    if (!outsideWorkspace(world_->state().position.col(node)).empty())
+      throw std::runtime_error(private_nh_.resolveName("workspace_radius") + ": the scene's node " +
+                               std::to_string(node) + " lies outside it: " +
+                               outsideWorkspace(world_->state().position.col(node)));
 
   markers_publisher_ = private_nh_.advertise<visualization_msgs::MarkerArray>("markers", 1);
   force_markers_publisher_ = private_nh_.advertise<visualization_msgs::MarkerArray>("force_markers", 1);
@@ -140,7 +149,10 @@ void SimNode::onTimer(const ros::TimerEvent&)
   if (paused_)
     epoch_ += ros::Duration(elapsed);  // simulated time stands still while ROS time goes on
   else
+  {
+    noteHeldNodes();
     advance(now, elapsed);
+  }
   if (!paused_ && epoch_ != published_epoch_)
   {
     std_msgs::Time message;

@@ -2,6 +2,7 @@
 // its health on /diagnostics.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <ros/names.h>
 
@@ -119,6 +120,53 @@ std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& 
   return "";
 }
 
+void SimNode::noteHeldNodes()
+{
+  held_.clear();
+  const Model& model = world_->model();
+  const NodeArray& position = world_->state().position;
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+    for (const Anchor& anchor : model.anchors)
+      if (anchor.body == model.bodies[b].name)
+        held_.push_back({ b, "anchor '" + anchor.name + "'", anchor.node, position.col(anchor.node) });
+  for (const GraspedNodes& grasp : world_->grasps())
+    for (const int node : grasp.nodes)
+      held_.push_back({ grasp.body, "grasp '" + grasp.name + "'", node, position.col(node) });
+}
+
+std::string SimNode::inputJump(std::size_t body) const
+{
+  const NodeArray& position = world_->state().position;
+  const HeldNode* largest = nullptr;
+  double jump = 0.0;
+  for (const HeldNode& held : held_)
+  {
+    const double moved = (position.col(held.node) - held.start).norm();
+    if (held.body == body && moved > jump)
+    {
+      jump = moved;
+      largest = &held;
+    }
+  }
+  if (!largest)
+    return std::string();
+  // The body's size: the box around its other nodes, which the guard has just put back where they were
+  // good. A hand carries a body less than its own size in one tick (1/60 s: 60 sizes per second); a pose
+  // that leaps further is a jump in the input, and it is what drags the body's springs past what any step
+  // resolves.
+  const BodyRange& range = world_->model().bodies[body];
+  Eigen::AlignedBox3d box;
+  for (int node = range.first; node < range.first + range.count; ++node)
+    if (std::none_of(held_.begin(), held_.end(), [node](const HeldNode& held) { return held.node == node; }))
+      box.extend(position.col(node));
+  const double size = box.isEmpty() ? 0.0 : box.diagonal().norm();
+  if (jump <= size)
+    return std::string();
+  char text[160];
+  std::snprintf(text, sizeof text, " moved its node %g m in this tick, more than the body's size (%g m)", jump, size);
+  return largest->holder + text;
+}
+
 void SimNode::watchDivergence()
 {
   max_strain_ = maxStrain(world_->model(), world_->state());
@@ -126,8 +174,16 @@ void SimNode::watchDivergence()
   for (const DivergenceEvent& event : world_->takeDivergenceEvents())
   {
     ++statistics_.divergence_events;
-    ROS_ERROR("%s: %s; lower dt or stiffness, or pick a stable integrator, then call ~reset", name_.c_str(),
-              event.describe().c_str());
+    const std::vector<BodyRange>& bodies = world_->model().bodies;
+    const auto body = std::find_if(bodies.begin(), bodies.end(), [&](const BodyRange& b) { return b.name == event.body; });
+    const std::string jump =
+        body == bodies.end() ? std::string() : inputJump(static_cast<std::size_t>(body - bodies.begin()));
+    if (!jump.empty())
+      ROS_ERROR("%s: %s; likely cause: an input jump (%s): move it in smaller steps, then call ~reset", name_.c_str(),
+                event.describe().c_str(), jump.c_str());
+    else
+      ROS_ERROR("%s: %s; lower dt or stiffness, or pick a stable integrator, then call ~reset", name_.c_str(),
+                event.describe().c_str());
   }
 }
 
