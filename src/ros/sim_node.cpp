@@ -40,6 +40,15 @@ void SimNode::initialize()
   rate_ = scene_.rate;
   if (private_nh_.getParam("rate", rate_) && !(rate_ > 0.0 && std::isfinite(rate_)))
     throw std::runtime_error(private_nh_.resolveName("rate") + ": must be a finite number > 0 [Hz]");
+  // Below one tick's period, so that a tick leaves time for the callbacks (services, inputs) before the next.
+  tick_budget_ = 0.8 / rate_;
+  if (private_nh_.hasParam("tick_budget") &&
+      !(private_nh_.getParam("tick_budget", tick_budget_) && tick_budget_ > 0.0 && std::isfinite(tick_budget_)))
+    throw std::runtime_error(private_nh_.resolveName("tick_budget") + ": must be a finite number > 0 [s]");
+  if (private_nh_.hasParam("workspace_radius") &&
+      !(private_nh_.getParam("workspace_radius", workspace_radius_) && workspace_radius_ > 0.0 &&
+        std::isfinite(workspace_radius_)))
+    throw std::runtime_error(private_nh_.resolveName("workspace_radius") + ": must be a finite number > 0 [m]");
   private_nh_.param("status_period", status_period_, 0.0);
   if (private_nh_.getParam("force_scale", force_scale_) && !(force_scale_ > 0.0 && std::isfinite(force_scale_)))
     throw std::runtime_error(private_nh_.resolveName("force_scale") + ": must be a finite number > 0 [m/N]");
@@ -51,6 +60,11 @@ void SimNode::initialize()
     start_time_ = fromMilliseconds(start_time);
   }
   buildWorldFromScene();
+  for (int node = 0; node < world_->model().nodeCount(); ++node)
+    if (!outsideWorkspace(world_->state().position.col(node)).empty())
+      throw std::runtime_error(private_nh_.resolveName("workspace_radius") + ": the scene's node " +
+                               std::to_string(node) + " lies outside it: " +
+                               outsideWorkspace(world_->state().position.col(node)));
 
   markers_publisher_ = private_nh_.advertise<visualization_msgs::MarkerArray>("markers", 1);
   force_markers_publisher_ = private_nh_.advertise<visualization_msgs::MarkerArray>("force_markers", 1);
@@ -135,7 +149,10 @@ void SimNode::onTimer(const ros::TimerEvent&)
   if (paused_)
     epoch_ += ros::Duration(elapsed);  // simulated time stands still while ROS time goes on
   else
+  {
+    noteHeldNodes();
     advance(now, elapsed);
+  }
   if (!paused_ && epoch_ != published_epoch_)
   {
     std_msgs::Time message;
@@ -172,15 +189,31 @@ void SimNode::advance(const ros::Time& now, double elapsed)
     epoch_ += ros::Duration((steps - max_steps_per_tick_) * dt);  // the dropped time
     steps = max_steps_per_tick_;
   }
+  // The budget is checked between steps (a step cannot be cut short): one step always runs, so that a
+  // step dearer than the budget still moves simulated time on, a tick at a time.
   const auto start = std::chrono::steady_clock::now();
-  for (long n = 0; n < steps; ++n)
+  const auto deadline = start + std::chrono::duration<double>(tick_budget_);
+  long taken = 0;
+  for (; taken < steps; ++taken)
   {
+    if (taken > 0 && std::chrono::steady_clock::now() > deadline)
+      break;
     applyDueInputs(rosTime(world_->time() + dt));
     world_->step();
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (steps > 0)
-    statistics_.wall_seconds_per_step = wall / static_cast<double>(steps);
+  if (taken > 0)
+    statistics_.wall_seconds_per_step = wall / static_cast<double>(taken);
+  if (taken < steps)
+  {
+    warnOverBudget(steps, taken, wall);
+    // In wall-clock time the steps not taken are dropped, as when falling behind: the next tick starts
+    // from now, and a node that cannot keep real time never builds a backlog. Under /use_sim_time they
+    // stay due: the next tick takes them, so that a replay takes every step, only later.
+    if (!ros::Time::isSimTime())
+      epoch_ += ros::Duration(static_cast<double>(steps - taken) * dt);
+  }
+  steps = taken;
   // Whole steps per tick alternate (e.g. 3 and 4 steps of 5 ms in 16.7 ms ticks): the real-time factor
   // is taken over windows of at least half a second.
   window_elapsed_ += elapsed;
@@ -190,6 +223,24 @@ void SimNode::advance(const ros::Time& now, double elapsed)
     statistics_.real_time_factor = window_simulated_ / window_elapsed_;
     window_elapsed_ = window_simulated_ = 0.0;
   }
+}
+
+void SimNode::warnOverBudget(long steps, long taken, double wall) const
+{
+  const double dt = world_->settings().dt;
+  // The pace of this tick's stepping: simulated seconds per wall second.
+  const double factor = static_cast<double>(taken) * dt / wall;
+  if (ros::Time::isSimTime())
+    ROS_WARN_THROTTLE(5.0,
+                      "%s: a tick ran out of ~tick_budget = %g s after %ld of %ld steps (real-time factor %.3g): "
+                      "the other steps follow in the next ticks, behind /clock; slow the clock down to keep pace",
+                      name_.c_str(), tick_budget_, taken, steps, factor);
+  else
+    ROS_WARN_THROTTLE(5.0,
+                      "%s: a tick ran out of ~tick_budget = %g s after %ld of %ld steps (real-time factor %.3g): "
+                      "%g s of simulation dropped; lower substeps or iterations, raise dt, or run under "
+                      "/use_sim_time with a slower clock",
+                      name_.c_str(), tick_budget_, taken, steps, factor, static_cast<double>(steps - taken) * dt);
 }
 
 void SimNode::publish()

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 
@@ -226,6 +227,14 @@ bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::st
   std::string why;
   std::optional<Eigen::Quaterniond> unused;
   std::optional<Eigen::Quaterniond>& turn = orientation ? *orientation : unused;
+  // Finite but absurd (x = 1e30): a body dragged there diverges, publishes 1e30 m and stays there.
+  const auto inWorkspace = [&]() {
+    why = outsideWorkspace(position);
+    if (why.empty())
+      return true;
+    ROS_WARN_THROTTLE(5.0, "%s: pose dropped: %s", topic.c_str(), why.c_str());
+    return false;
+  };
   if (!RosConverter::fromPose(pose.pose, position, turn, why))
   {
     ROS_WARN_THROTTLE(5.0, "%s: pose dropped: %s", topic.c_str(), why.c_str());
@@ -243,7 +252,7 @@ bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::st
     return false;
   }
   if (pose.header.frame_id == scene_.frame_id)
-    return true;  // no lookup: the same with or without tf data
+    return inWorkspace();  // no lookup: the same with or without tf data
   try
   {
     geometry_msgs::PoseStamped in_scene;
@@ -273,11 +282,24 @@ bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::st
                       pose.header.frame_id.c_str(), scene_.frame_id.c_str(), e.what());
     return false;
   }
-  return true;
+  return inWorkspace();
 }
 
-std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros::Time& stamp)
+std::string SimNode::outsideWorkspace(const Vec3& position) const
 {
+  const double distance = position.stableNorm();  // no overflow to infinity at 1e300
+  if (distance <= workspace_radius_)
+    return std::string();
+  char text[128];
+  std::snprintf(text, sizeof text, "%g m from the origin of the scene frame, beyond ~workspace_radius = %g m",
+                distance, workspace_radius_);
+  return text;
+}
+
+std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros::Time& stamp, std::string* why)
+{
+  std::string unused;
+  std::string& reason = why ? *why : unused;
   geometry_msgs::TransformStamped transform;
   try
   {
@@ -297,6 +319,7 @@ std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros:
   }
   catch (const tf2::TransformException& e)
   {
+    reason = "no transform from '" + frame + "' to '" + scene_.frame_id + "'";
     // At start-up the frame's publisher (robot_state_publisher, a driver) may come up a little later: a
     // frame still missing after kFrameGraceSeconds of simulated time is worth a warning.
     if ((stamp - epoch_).toSec() < kFrameGraceSeconds)
@@ -309,14 +332,24 @@ std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros:
   }
   const std::optional<RigidPose> pose = RosConverter::toRigidPose(transform.transform);
   if (!pose)
-    ROS_WARN_THROTTLE(5.0, "%s: the transform from '%s' to '%s' is not finite or has a zero rotation", name_.c_str(),
-                      frame.c_str(), scene_.frame_id.c_str());
+  {
+    reason = "the transform from '" + frame + "' to '" + scene_.frame_id + "' is not finite or has a zero rotation";
+    ROS_WARN_THROTTLE(5.0, "%s: %s", name_.c_str(), reason.c_str());
+    return std::nullopt;
+  }
+  reason = outsideWorkspace(pose->position);
+  if (!reason.empty())
+  {
+    reason = "tf frame '" + frame + "' is " + reason;
+    ROS_WARN_THROTTLE(5.0, "%s: %s: ignored", name_.c_str(), reason.c_str());
+    return std::nullopt;
+  }
   return pose;
 }
 
-std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Time& stamp)
+std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Time& stamp, std::string* why)
 {
-  const std::optional<RigidPose> pose = framePose(frame, stamp);
+  const std::optional<RigidPose> pose = framePose(frame, stamp, why);
   return pose ? std::optional<Vec3>(pose->position) : std::nullopt;
 }
 
@@ -362,9 +395,10 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
   for (const Anchor& anchor : world_->model().anchors)
     if (anchor.name == request.frame && world_->isAttached(*world_->findAnchor(anchor.body, anchor.name)))
       return refuse("frame '" + request.frame + "' already holds a node of '" + anchor.body + "'");
-  const std::optional<Vec3> origin = frameOrigin(request.frame, ros::Time(0));
+  std::string unusable;
+  const std::optional<Vec3> origin = frameOrigin(request.frame, ros::Time(0), &unusable);
   if (!origin)
-    return refuse("no transform from '" + request.frame + "' to '" + scene_.frame_id + "'");
+    return refuse(unusable);
   const std::optional<int> node = world_->nearestFreeNode(*origin, request.body, request.radius);
   if (!node)
     return refuse("no free node" + (request.body.empty() ? std::string() : " of '" + request.body + "'") + " within " +
@@ -428,9 +462,10 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
       return refuse(why);
   if (!(request.max_force >= 0.0 && std::isfinite(request.max_force)))
     return refuse("max_force must be a finite number >= 0 [N] (0: no limit), not " + std::to_string(request.max_force));
-  const std::optional<RigidPose> pose = framePose(request.frame, ros::Time(0));
+  std::string unusable;
+  const std::optional<RigidPose> pose = framePose(request.frame, ros::Time(0), &unusable);
   if (!pose)
-    return refuse("no transform from '" + request.frame + "' to '" + scene_.frame_id + "'");
+    return refuse(unusable);
   const double max_force = request.max_force > 0.0 ? request.max_force : std::numeric_limits<double>::infinity();
   try
   {

@@ -1,6 +1,8 @@
 // SimNode's live tuning (dynamic_reconfigure: ~ for the physics, ~<body> for each body's material) and
 // its health on /diagnostics.
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include <ros/names.h>
 
@@ -65,6 +67,8 @@ std::string SimNode::applySimConfig(const SimConfig& config)
   if (settings.dt != world_->settings().dt || settings.substeps != world_->settings().substeps ||
       settings.iterations != world_->settings().iterations)
   {
+    if (integrator == world_->integrator())
+      warnIfSlowerThanRealTime(settings);
     world_->setStepSettings(settings);
     max_steps_per_tick_ = std::max(1L, std::lround(std::ceil(2.0 / (rate_ * settings.dt))));
   }
@@ -76,6 +80,29 @@ std::string SimNode::applySimConfig(const SimConfig& config)
            name_.c_str(), config.integrator.c_str(), config.dt, config.substeps, config.iterations, gravity.x(),
            gravity.y(), gravity.z(), config.drag);
   return "";
+}
+
+void SimNode::warnIfSlowerThanRealTime(const StepSettings& settings) const
+{
+  const StepSettings& now = world_->settings();
+  const double cost = statistics_.wall_seconds_per_step;  // [s] measured at `now`'s settings
+  if (!(cost > 0.0))
+    return;  // nothing measured yet
+  // A lower bound on the new step's cost: every stage runs once per sub-step, so the cost grows at least
+  // with the sub-steps; only some stages repeat per iteration (constraint sweeps, Newton solves), so more
+  // iterations cost more by at most their ratio, and fewer save at most that much. Warned only when even
+  // this bound cannot keep real time: the warning is then certain, whatever the integrator spends where.
+  const double iterations = static_cast<double>(settings.iterations) / now.iterations;
+  const double estimate = cost * settings.substeps / now.substeps * std::min(1.0, iterations);
+  const double factor = settings.dt / estimate;  // simulated seconds per wall second, at most
+  if (factor >= 1.0)
+    return;
+  ROS_WARN("%s: dt = %g s with %d substeps and %d iterations cannot keep real time on this scene: a step "
+           "costs at least %.3g s (measured %.3g s at dt = %g s, %d substeps, %d iterations), a real-time factor of "
+           "at most %.3g; each tick stops stepping after ~tick_budget = %g s and %s",
+           name_.c_str(), settings.dt, settings.substeps, settings.iterations, estimate, cost, now.dt, now.substeps,
+           now.iterations, factor, tick_budget_,
+           ros::Time::isSimTime() ? "the other steps follow later, behind /clock" : "the time left is dropped");
 }
 
 std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& config)
@@ -93,6 +120,53 @@ std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& 
   return "";
 }
 
+void SimNode::noteHeldNodes()
+{
+  held_.clear();
+  const Model& model = world_->model();
+  const NodeArray& position = world_->state().position;
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+    for (const Anchor& anchor : model.anchors)
+      if (anchor.body == model.bodies[b].name)
+        held_.push_back({ b, "anchor '" + anchor.name + "'", anchor.node, position.col(anchor.node) });
+  for (const GraspedNodes& grasp : world_->grasps())
+    for (const int node : grasp.nodes)
+      held_.push_back({ grasp.body, "grasp '" + grasp.name + "'", node, position.col(node) });
+}
+
+std::string SimNode::inputJump(std::size_t body) const
+{
+  const NodeArray& position = world_->state().position;
+  const HeldNode* largest = nullptr;
+  double jump = 0.0;
+  for (const HeldNode& held : held_)
+  {
+    const double moved = (position.col(held.node) - held.start).norm();
+    if (held.body == body && moved > jump)
+    {
+      jump = moved;
+      largest = &held;
+    }
+  }
+  if (!largest)
+    return std::string();
+  // The body's size: the box around its other nodes, which the guard has just put back where they were
+  // good. A hand carries a body less than its own size in one tick (1/60 s: 60 sizes per second); a pose
+  // that leaps further is a jump in the input, and it is what drags the body's springs past what any step
+  // resolves.
+  const BodyRange& range = world_->model().bodies[body];
+  Eigen::AlignedBox3d box;
+  for (int node = range.first; node < range.first + range.count; ++node)
+    if (std::none_of(held_.begin(), held_.end(), [node](const HeldNode& held) { return held.node == node; }))
+      box.extend(position.col(node));
+  const double size = box.isEmpty() ? 0.0 : box.diagonal().norm();
+  if (jump <= size)
+    return std::string();
+  char text[160];
+  std::snprintf(text, sizeof text, " moved its node %g m in this tick, more than the body's size (%g m)", jump, size);
+  return largest->holder + text;
+}
+
 void SimNode::watchDivergence()
 {
   max_strain_ = maxStrain(world_->model(), world_->state());
@@ -100,8 +174,16 @@ void SimNode::watchDivergence()
   for (const DivergenceEvent& event : world_->takeDivergenceEvents())
   {
     ++statistics_.divergence_events;
-    ROS_ERROR("%s: %s; lower dt or stiffness, or pick a stable integrator, then call ~reset", name_.c_str(),
-              event.describe().c_str());
+    const std::vector<BodyRange>& bodies = world_->model().bodies;
+    const auto body = std::find_if(bodies.begin(), bodies.end(), [&](const BodyRange& b) { return b.name == event.body; });
+    const std::string jump =
+        body == bodies.end() ? std::string() : inputJump(static_cast<std::size_t>(body - bodies.begin()));
+    if (!jump.empty())
+      ROS_ERROR("%s: %s; likely cause: an input jump (%s): move it in smaller steps, then call ~reset", name_.c_str(),
+                event.describe().c_str(), jump.c_str());
+    else
+      ROS_ERROR("%s: %s; lower dt or stiffness, or pick a stable integrator, then call ~reset", name_.c_str(),
+                event.describe().c_str());
   }
 }
 

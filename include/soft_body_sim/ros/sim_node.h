@@ -50,8 +50,12 @@ public:
 private:
   // --- time (sim_node.cpp)
   void onTimer(const ros::TimerEvent& event);
-  /// Simulates whole steps up to `now`, at most max_steps_per_tick_ of them (no cap under /use_sim_time).
+  /// Simulates whole steps up to `now`, at most max_steps_per_tick_ of them (no cap under /use_sim_time),
+  /// and none begun after tick_budget_ of wall time: in wall-clock time the steps left are dropped, under
+  /// /use_sim_time they wait for the next tick.
   void advance(const ros::Time& now, double elapsed);
+  /// Warns (throttled) that a tick ran out of tick_budget_ after `taken` of `steps` steps in `wall` [s].
+  void warnOverBudget(long steps, long taken, double wall) const;
   /// The ROS time of the simulated instant world time `t` [s].
   ros::Time rosTime(double t) const { return epoch_ + ros::Duration(t); }
   /// Publishes markers and state stamped with the ROS time of the simulated instant, and the handles.
@@ -78,11 +82,14 @@ private:
   /// `topic` and the reason) if it is not finite or its frame cannot be transformed.
   bool toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position,
                     std::optional<Eigen::Quaterniond>* orientation = nullptr);
+  /// Why a position [m] in the scene frame is no input the node takes (beyond ~workspace_radius), or empty.
+  std::string outsideWorkspace(const Vec3& position) const;
   /// The pose of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf has
-  /// none that recent yet); nullopt with a throttled warning if tf has none at all.
-  std::optional<RigidPose> framePose(const std::string& frame, const ros::Time& stamp);
+  /// none that recent yet); nullopt with a throttled warning if tf has none at all, or one that is not
+  /// finite or beyond ~workspace_radius; `why`, if given, is set to the reason.
+  std::optional<RigidPose> framePose(const std::string& frame, const ros::Time& stamp, std::string* why = nullptr);
   /// framePose's position.
-  std::optional<Vec3> frameOrigin(const std::string& frame, const ros::Time& stamp);
+  std::optional<Vec3> frameOrigin(const std::string& frame, const ros::Time& stamp, std::string* why = nullptr);
   /// Makes anchor `anchor` follow tf frame `frame` every step.
   void followFrame(int anchor, const std::string& frame);
   /// The scene's robot_colliders: the URDF's collisions join scene_'s colliders (throws, saying why).
@@ -101,9 +108,18 @@ private:
   void startReconfigure();
   /// Applies `config` to the world; an empty string, or why it cannot.
   std::string applySimConfig(const SimConfig& config);
+  /// Warns when stepping at `settings` cannot keep real time on this scene, by the measured step cost
+  /// scaled to the new sub-steps and iterations (before the change: the cost measured is the old one).
+  void warnIfSlowerThanRealTime(const StepSettings& settings) const;
   std::string applyBodyConfig(const std::string& body, const BodyConfig& config);
   void diagnose(diagnostic_updater::DiagnosticStatusWrapper& status);
-  /// Logs the divergence guard's catches of the last tick and measures the largest strain.
+  /// Notes where every node held by an anchor or grasp is as a tick begins (HeldNode).
+  void noteHeldNodes();
+  /// "anchor 'end' moved its node 1e+03 m ..." if an anchor or grasp of body `body` carried a node
+  /// further in the last tick than the body's free nodes span: an input jump. Empty otherwise.
+  std::string inputJump(std::size_t body) const;
+  /// Logs the divergence guard's catches of the last tick, naming an input jump where there was one,
+  /// and measures the largest strain.
   void watchDivergence();
   /// Logs the grasps that slipped in the last tick and keeps them for the next state message.
   void watchGrasps();
@@ -120,6 +136,8 @@ private:
   double rate_ = 60.0;          ///< [Hz] of the timer
   double status_period_ = 0.0;  ///< [s] between status lines on the console; 0 = none
   long max_steps_per_tick_ = 1;  ///< catch-up cap: two ticks' worth of steps
+  double tick_budget_ = 0.0;     ///< ~tick_budget [s]: wall time after which a tick begins no further step
+  double workspace_radius_ = 1.0e4;  ///< ~workspace_radius [m]: inputs further from the scene origin are dropped
 
   tf2_ros::Buffer tf_buffer_;
   tf2_ros::TransformListener tf_listener_;
@@ -161,6 +179,15 @@ private:
   StepStatistics statistics_;
   double max_strain_ = 0.0;       ///< [-] largest |l - L| / L of a spring or constraint, last tick
   std::vector<GraspSlip> slips_;  ///< grasps that slipped since the last state message
+  /// A node held by an anchor or a grasp, where it was as the tick began.
+  struct HeldNode
+  {
+    std::size_t body;    ///< index into Model::bodies
+    std::string holder;  ///< "anchor 'end'" or "grasp 'hand'"
+    int node;            ///< global node index
+    Vec3 start;          ///< [m]
+  };
+  std::vector<HeldNode> held_;  ///< as the current tick began
   double force_scale_ = 0.02;     ///< ~force_scale [m/N]: length of the force arrows on ~force_markers
 };
 
