@@ -7,10 +7,10 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <sstream>
 
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
+#include "ros/node_parameters.h"
 #include "soft_body_sim/core/elements/rods.h"
 #include "soft_body_sim/ros/sim_node.h"
 
@@ -41,47 +41,18 @@ std::string badName(const std::string& what, const std::string& name)
       return what + " holds a control character";
   return std::string();
 }
-
-/// The parameter's value for an error message: a string quoted, a bool as a bool (XmlRpc writes 1).
-std::string shown(const ros::NodeHandle& nh, const std::string& key)
-{
-  XmlRpc::XmlRpcValue value;
-  nh.getParam(key, value);
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeBoolean)
-    return static_cast<bool>(value) ? "true" : "false";
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeString)
-    return "'" + static_cast<std::string>(value).substr(0, 64) + "'";
-  std::ostringstream out;
-  value.write(out);
-  return out.str().substr(0, 64);
-}
-
-/// ~key in seconds, finite and > 0; `fallback` when it is not set. Throws, naming it, otherwise.
-double positiveSeconds(const ros::NodeHandle& nh, const std::string& key, double fallback)
-{
-  if (!nh.hasParam(key))
-    return fallback;
-  double value = 0.0;
-  if (!nh.getParam(key, value) || !(value > 0.0 && std::isfinite(value)))
-    throw std::runtime_error(nh.resolveName(key) + ": must be a finite number of seconds > 0, not " + shown(nh, key));
-  return value;
-}
 }  // namespace
 
 InputLimits SimNode::readInputLimits() const
 {
+  const std::string seconds = "a finite number of seconds > 0";
   InputLimits limits;
-  limits.max_age = positiveSeconds(private_nh_, "max_input_age", limits.max_age);
-  limits.max_lead = positiveSeconds(private_nh_, "max_input_lead", limits.max_lead);
-  // Read raw: roscpp's getParam(int) would round a double (2.5 -> 3) instead of refusing it.
-  XmlRpc::XmlRpcValue held;
-  if (private_nh_.getParam("max_held_inputs", held))
-  {
-    if (held.getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(held) < 1)
-      throw std::runtime_error(private_nh_.resolveName("max_held_inputs") + ": must be an integer >= 1, not " +
-                               shown(private_nh_, "max_held_inputs"));
-    limits.max_held = static_cast<std::size_t>(static_cast<int>(held));
-  }
+  limits.max_age = readParam<double>(private_nh_, "max_input_age", seconds, finitePositive).value_or(limits.max_age);
+  limits.max_lead =
+      readParam<double>(private_nh_, "max_input_lead", seconds, finitePositive).value_or(limits.max_lead);
+  limits.max_held = static_cast<std::size_t>(
+      readParam<int>(private_nh_, "max_held_inputs", "an integer >= 1", [](const int& n) { return n >= 1; })
+          .value_or(static_cast<int>(limits.max_held)));
   return limits;
 }
 
