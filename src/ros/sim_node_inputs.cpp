@@ -192,9 +192,26 @@ void SimNode::warnIfRodEndJumps(const ScheduledInput& input) const
                     static_cast<int>(std::ceil(jump / segment)));
 }
 
+std::string SimNode::tfFrame(const std::string& frame, const std::string& source)
+{
+  if (frame.empty() || frame[0] != '/')
+    return frame;
+  // Not quoted: the name is checked (length, control characters) only after this.
+  if (slash_warned_.insert(source).second)
+    ROS_WARN("%s: a frame name with a leading slash is taken without it (tf2 refuses the slash of tf1); "
+             "warned once for this source", source.c_str());
+  return frame.substr(std::min(frame.find_first_not_of('/'), frame.size()));
+}
+
 bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position,
                            std::optional<Eigen::Quaterniond>* orientation)
 {
+  if (!pose.header.frame_id.empty() && pose.header.frame_id[0] == '/')
+  {
+    geometry_msgs::PoseStamped relative = pose;
+    relative.header.frame_id = tfFrame(pose.header.frame_id, topic);  // no slash left: no further turn here
+    return toSceneFrame(relative, topic, position, orientation);
+  }
   std::string why;
   std::optional<Eigen::Quaterniond> unused;
   std::optional<Eigen::Quaterniond>& turn = orientation ? *orientation : unused;
@@ -351,6 +368,7 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
     ROS_WARN("%s: attach refused: %s", name_.c_str(), why.c_str());
     return true;
   };
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("attach"));
   if (request.frame.empty())
     return refuse("no frame given");
   for (const std::string& why : { badName("frame name", request.frame), badName("body name", request.body) })
@@ -397,6 +415,7 @@ bool SimNode::onDetach(Detach::Request& request, Detach::Response& response)
     ROS_WARN("%s: detach refused: %s", name_.c_str(), why.c_str());
     return true;
   };
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("detach"));
   if (request.frame.empty())
     return refuse("no frame given");
   const std::string why = badName("frame name", request.frame);
@@ -424,6 +443,7 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
     ROS_WARN("%s: grasp refused: %s", name_.c_str(), why.c_str());
     return true;
   };
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("grasp"));
   if (request.frame.empty())
     return refuse("no frame given");
   if (request.body.empty())
@@ -462,6 +482,7 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
 
 bool SimNode::onRelease(Detach::Request& request, Detach::Response& response)
 {
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("release"));
   const std::string why = request.frame.empty() ? "no frame given" : badName("frame name", request.frame);
   if (!why.empty() || !world_->release(request.frame))
   {
