@@ -12,6 +12,7 @@
 
 #include "ros/node_parameters.h"
 #include "soft_body_sim/core/elements/rods.h"
+#include "soft_body_sim/core/format_number.h"
 #include "soft_body_sim/ros/sim_node.h"
 
 namespace soft_body_sim
@@ -380,7 +381,7 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
       }))
     return refuse("no body '" + request.body + "' in the scene");
   if (!(request.radius > 0.0 && std::isfinite(request.radius)))
-    return refuse("radius must be a finite number > 0 [m], not " + std::to_string(request.radius));
+    return refuse("radius must be a finite number > 0 [m], not " + formatNumber(request.radius));
   for (const Anchor& anchor : world_->model().anchors)
     if (anchor.name == request.frame && world_->isAttached(*world_->findAnchor(anchor.body, anchor.name)))
       return refuse("frame '" + request.frame + "' already holds a node of '" + anchor.body + "'");
@@ -391,7 +392,7 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
   const std::optional<int> node = world_->nearestFreeNode(*origin, request.body, request.radius);
   if (!node)
     return refuse("no free node" + (request.body.empty() ? std::string() : " of '" + request.body + "'") + " within " +
-                  std::to_string(request.radius) + " m of '" + request.frame + "'");
+                  formatNumber(request.radius) + " m of '" + request.frame + "'");
   const int anchor = world_->attach(*node, request.frame);
   followFrame(anchor, request.frame);
   const Anchor& made = world_->model().anchors[static_cast<std::size_t>(anchor)];
@@ -452,7 +453,7 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
     if (!why.empty())
       return refuse(why);
   if (!(request.max_force >= 0.0 && std::isfinite(request.max_force)))
-    return refuse("max_force must be a finite number >= 0 [N] (0: no limit), not " + std::to_string(request.max_force));
+    return refuse("max_force must be a finite number >= 0 [N] (0: no limit), not " + formatNumber(request.max_force));
   std::string unusable;
   const std::optional<RigidPose> pose = framePose(request.frame, ros::Time(0), &unusable);
   if (!pose)
@@ -475,7 +476,7 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
   response.success = true;
   response.message = "'" + request.frame + "' holds " + std::to_string(grasp.nodes.size()) + " node(s) of '" +
                      request.body + "'" +
-                     (request.max_force > 0.0 ? " up to " + std::to_string(request.max_force) + " N" : std::string());
+                     (request.max_force > 0.0 ? " up to " + formatNumber(request.max_force) + " N" : std::string());
   ROS_INFO("%s: %s", name_.c_str(), response.message.c_str());
   return true;
 }
