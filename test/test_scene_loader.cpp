@@ -1248,6 +1248,9 @@ TEST(SceneLoader, BadMeshCollidersAreRejectedWithOneLineAtTheKey)
                    "bad.yaml:1: colliders[0].voxel_size", { "> 0" });
   expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", voxel_size: 0.00001}]\n" + body,
                    "bad.yaml:1: colliders[0].voxel_size", { "voxels, more than the 16777216 allowed" });
+  // Printed as %g writes it: std::to_string's %f made this "voxel_size 0.000000 m".
+  expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", voxel_size: 1.0e-7}]\n" + body,
+                   "bad.yaml:1: colliders[0].voxel_size", { "voxel_size 1e-07 m spans" });
   expectSceneError("colliders: [{name: a, shape: mesh}]\n" + body, "bad.yaml:1: colliders[0].mesh",
                    { "missing required key" });
   expectSceneError("colliders: [{name: a, shape: mesh, mesh: " + part + ", size: [1, 1, 1]}]\n" + body,

@@ -33,7 +33,7 @@ visualization_msgs::InteractiveMarkerControl axisControl(const std::string& name
 }  // namespace
 
 AnchorHandles::AnchorHandles(const std::string& topic_ns, const std::string& frame_id)
-  : frame_id_(frame_id), server_(topic_ns)
+  : frame_id_(frame_id), server_topic_(topic_ns), server_(topic_ns)
 {
 }
 
@@ -82,6 +82,18 @@ void AnchorHandles::onFeedback(const visualization_msgs::InteractiveMarkerFeedba
   const auto it = handles_.find(feedback->marker_name);
   if (it == handles_.end())
     return;
+  Vec3 position;
+  std::string why;
+  if (!RosConverter::fromPose(feedback->pose, position, why))
+  {
+    // The server has already taken the pose for the handle's next update (processFeedback, before this
+    // callback): put the handle back where it was, so that no client is sent the non-finite pose.
+    ROS_WARN_THROTTLE(5.0, "%s: handle '%s' feedback dropped: %s", server_topic_.c_str(),
+                      feedback->marker_name.c_str(), why.c_str());
+    server_.setPose(feedback->marker_name, RosConverter::toPose(it->second.shown));
+    changed_ = true;
+    return;
+  }
   geometry_msgs::PoseStamped pose;
   pose.header.frame_id = feedback->header.frame_id.empty() ? frame_id_ : feedback->header.frame_id;
   // Stamped now, as a node publishing on the topic would: the node schedules the input by this stamp
@@ -89,7 +101,7 @@ void AnchorHandles::onFeedback(const visualization_msgs::InteractiveMarkerFeedba
   pose.header.stamp = ros::Time::now();
   pose.pose = feedback->pose;
   it->second.publisher.publish(pose);
-  it->second.shown = RosConverter::toVec3(feedback->pose.position);
+  it->second.shown = position;
   it->second.dragged_until = ros::WallTime::now() + ros::WallDuration(kDragHold);
 }
 

@@ -9,6 +9,7 @@
 #include "soft_body_sim/core/definition_error.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/scene/mesh_uri.h"
+#include "soft_body_sim/core/format_number.h"
 
 namespace soft_body_sim
 {
@@ -59,8 +60,8 @@ void addRobotColliders(const std::string& urdf_xml, const RobotCollidersDef& rob
         {
           // A URDF's relative mesh paths have no folder to be relative to: the working directory's.
           if (!(mesh.scale.minCoeff() > 0.0))
-            throw std::invalid_argument("scale " + std::to_string(mesh.scale.x()) + " " +
-                                        std::to_string(mesh.scale.y()) + " " + std::to_string(mesh.scale.z()) +
+            throw std::invalid_argument("scale " + formatNumber(mesh.scale.x()) + " " +
+                                        formatNumber(mesh.scale.y()) + " " + formatNumber(mesh.scale.z()) +
                                         " is not > 0 in every axis");
           const std::string path = resolveMeshUri(mesh.uri, "");
           mesh.triangles = std::make_shared<const TriangleMesh>(readTriangleMesh(path, mesh.scale));

@@ -5,6 +5,7 @@
 #include <ros/names.h>
 #include <std_msgs/Time.h>
 
+#include "ros/node_parameters.h"
 #include "soft_body_sim/SimState.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
 #include "soft_body_sim/ros/robot_colliders.h"
@@ -32,33 +33,28 @@ SimNode::SimNode(const ros::NodeHandle& nh, const ros::NodeHandle& private_nh, c
 
 void SimNode::initialize()
 {
-  if (!private_nh_.getParam("scene", scene_path_))
+  const std::optional<std::string> scene = readParam<std::string>(private_nh_, "scene", "the path of a scene file");
+  if (!scene)
     throw std::runtime_error(private_nh_.resolveName("scene") + ": parameter not set (the scene file to load)");
+  scene_path_ = *scene;
   scene_ = loadSceneFile(scene_path_);
   if (scene_.robot_colliders)
     addRobotColliders();
-  rate_ = scene_.rate;
-  if (private_nh_.getParam("rate", rate_) && !(rate_ > 0.0 && std::isfinite(rate_)))
-    throw std::runtime_error(private_nh_.resolveName("rate") + ": must be a finite number > 0 [Hz]");
+  rate_ = readParam<double>(private_nh_, "rate", "a finite number > 0 [Hz]", finitePositive).value_or(scene_.rate);
   // Below one tick's period, so that a tick leaves time for the callbacks (services, inputs) before the next.
-  tick_budget_ = 0.8 / rate_;
-  if (private_nh_.hasParam("tick_budget") &&
-      !(private_nh_.getParam("tick_budget", tick_budget_) && tick_budget_ > 0.0 && std::isfinite(tick_budget_)))
-    throw std::runtime_error(private_nh_.resolveName("tick_budget") + ": must be a finite number > 0 [s]");
-  if (private_nh_.hasParam("workspace_radius") &&
-      !(private_nh_.getParam("workspace_radius", workspace_radius_) && workspace_radius_ > 0.0 &&
-        std::isfinite(workspace_radius_)))
-    throw std::runtime_error(private_nh_.resolveName("workspace_radius") + ": must be a finite number > 0 [m]");
-  private_nh_.param("status_period", status_period_, 0.0);
-  if (private_nh_.getParam("force_scale", force_scale_) && !(force_scale_ > 0.0 && std::isfinite(force_scale_)))
-    throw std::runtime_error(private_nh_.resolveName("force_scale") + ": must be a finite number > 0 [m/N]");
-  double start_time = 0.0;
-  if (private_nh_.getParam("start_time", start_time) && start_time != 0.0)
-  {
-    if (!(start_time > 0.0 && start_time < 4e9))
-      throw std::runtime_error(private_nh_.resolveName("start_time") + ": must be a ROS time in seconds (> 0), or 0");
+  tick_budget_ =
+      readParam<double>(private_nh_, "tick_budget", "a finite number > 0 [s]", finitePositive).value_or(0.8 / rate_);
+  workspace_radius_ = readParam<double>(private_nh_, "workspace_radius", "a finite number > 0 [m]", finitePositive)
+                          .value_or(workspace_radius_);
+  status_period_ =
+      readParam<double>(private_nh_, "status_period", "a finite number >= 0 [s]", finiteNonNegative).value_or(0.0);
+  force_scale_ = readParam<double>(private_nh_, "force_scale", "a finite number > 0 [m/N]", finitePositive)
+                     .value_or(force_scale_);
+  const double start_time = readParam<double>(private_nh_, "start_time", "a ROS time in seconds (> 0), or 0",
+                                              [](const double& t) { return t == 0.0 || (t > 0.0 && t < 4e9); })
+                                .value_or(0.0);
+  if (start_time != 0.0)
     start_time_ = fromMilliseconds(start_time);
-  }
   buildWorldFromScene();
   for (int node = 0; node < world_->model().nodeCount(); ++node)
     if (!outsideWorkspace(world_->state().position.col(node)).empty())
@@ -91,14 +87,15 @@ void SimNode::initialize()
 void SimNode::addRobotColliders()
 {
   const RobotCollidersDef& robot = *scene_.robot_colliders;
-  std::string urdf;
-  if (!nh_.getParam(robot.param, urdf))
+  const std::optional<std::string> urdf =
+      readParam<std::string>(nh_, robot.param, "a robot's URDF (" + scene_path_ + ": robot_colliders.param)");
+  if (!urdf)
     throw std::runtime_error(scene_path_ + ": robot_colliders.param: the parameter '" + nh_.resolveName(robot.param) +
                              "' is not set (it should hold the robot's URDF)");
   std::vector<std::string> skipped;
   try
   {
-    soft_body_sim::addRobotColliders(urdf, robot, scene_.colliders, skipped);
+    soft_body_sim::addRobotColliders(*urdf, robot, scene_.colliders, skipped);
   }
   catch (const std::invalid_argument& e)
   {

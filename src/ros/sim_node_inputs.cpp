@@ -7,11 +7,12 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <sstream>
 
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
+#include "ros/node_parameters.h"
 #include "soft_body_sim/core/elements/rods.h"
+#include "soft_body_sim/core/format_number.h"
 #include "soft_body_sim/ros/sim_node.h"
 
 namespace soft_body_sim
@@ -41,47 +42,18 @@ std::string badName(const std::string& what, const std::string& name)
       return what + " holds a control character";
   return std::string();
 }
-
-/// The parameter's value for an error message: a string quoted, a bool as a bool (XmlRpc writes 1).
-std::string shown(const ros::NodeHandle& nh, const std::string& key)
-{
-  XmlRpc::XmlRpcValue value;
-  nh.getParam(key, value);
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeBoolean)
-    return static_cast<bool>(value) ? "true" : "false";
-  if (value.getType() == XmlRpc::XmlRpcValue::TypeString)
-    return "'" + static_cast<std::string>(value).substr(0, 64) + "'";
-  std::ostringstream out;
-  value.write(out);
-  return out.str().substr(0, 64);
-}
-
-/// ~key in seconds, finite and > 0; `fallback` when it is not set. Throws, naming it, otherwise.
-double positiveSeconds(const ros::NodeHandle& nh, const std::string& key, double fallback)
-{
-  if (!nh.hasParam(key))
-    return fallback;
-  double value = 0.0;
-  if (!nh.getParam(key, value) || !(value > 0.0 && std::isfinite(value)))
-    throw std::runtime_error(nh.resolveName(key) + ": must be a finite number of seconds > 0, not " + shown(nh, key));
-  return value;
-}
 }  // namespace
 
 InputLimits SimNode::readInputLimits() const
 {
+  const std::string seconds = "a finite number of seconds > 0";
   InputLimits limits;
-  limits.max_age = positiveSeconds(private_nh_, "max_input_age", limits.max_age);
-  limits.max_lead = positiveSeconds(private_nh_, "max_input_lead", limits.max_lead);
-  // Read raw: roscpp's getParam(int) would round a double (2.5 -> 3) instead of refusing it.
-  XmlRpc::XmlRpcValue held;
-  if (private_nh_.getParam("max_held_inputs", held))
-  {
-    if (held.getType() != XmlRpc::XmlRpcValue::TypeInt || static_cast<int>(held) < 1)
-      throw std::runtime_error(private_nh_.resolveName("max_held_inputs") + ": must be an integer >= 1, not " +
-                               shown(private_nh_, "max_held_inputs"));
-    limits.max_held = static_cast<std::size_t>(static_cast<int>(held));
-  }
+  limits.max_age = readParam<double>(private_nh_, "max_input_age", seconds, finitePositive).value_or(limits.max_age);
+  limits.max_lead =
+      readParam<double>(private_nh_, "max_input_lead", seconds, finitePositive).value_or(limits.max_lead);
+  limits.max_held = static_cast<std::size_t>(
+      readParam<int>(private_nh_, "max_held_inputs", "an integer >= 1", [](const int& n) { return n >= 1; })
+          .value_or(static_cast<int>(limits.max_held)));
   return limits;
 }
 
@@ -221,9 +193,26 @@ void SimNode::warnIfRodEndJumps(const ScheduledInput& input) const
                     static_cast<int>(std::ceil(jump / segment)));
 }
 
+std::string SimNode::tfFrame(const std::string& frame, const std::string& source)
+{
+  if (frame.empty() || frame[0] != '/')
+    return frame;
+  // Not quoted: the name is checked (length, control characters) only after this.
+  if (slash_warned_.insert(source).second)
+    ROS_WARN("%s: a frame name with a leading slash is taken without it (tf2 refuses the slash of tf1); "
+             "warned once for this source", source.c_str());
+  return frame.substr(std::min(frame.find_first_not_of('/'), frame.size()));
+}
+
 bool SimNode::toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position,
                            std::optional<Eigen::Quaterniond>* orientation)
 {
+  if (!pose.header.frame_id.empty() && pose.header.frame_id[0] == '/')
+  {
+    geometry_msgs::PoseStamped relative = pose;
+    relative.header.frame_id = tfFrame(pose.header.frame_id, topic);  // no slash left: no further turn here
+    return toSceneFrame(relative, topic, position, orientation);
+  }
   std::string why;
   std::optional<Eigen::Quaterniond> unused;
   std::optional<Eigen::Quaterniond>& turn = orientation ? *orientation : unused;
@@ -380,6 +369,7 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
     ROS_WARN("%s: attach refused: %s", name_.c_str(), why.c_str());
     return true;
   };
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("attach"));
   if (request.frame.empty())
     return refuse("no frame given");
   for (const std::string& why : { badName("frame name", request.frame), badName("body name", request.body) })
@@ -391,7 +381,7 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
       }))
     return refuse("no body '" + request.body + "' in the scene");
   if (!(request.radius > 0.0 && std::isfinite(request.radius)))
-    return refuse("radius must be a finite number > 0 [m], not " + std::to_string(request.radius));
+    return refuse("radius must be a finite number > 0 [m], not " + formatNumber(request.radius));
   for (const Anchor& anchor : world_->model().anchors)
     if (anchor.name == request.frame && world_->isAttached(*world_->findAnchor(anchor.body, anchor.name)))
       return refuse("frame '" + request.frame + "' already holds a node of '" + anchor.body + "'");
@@ -402,7 +392,7 @@ bool SimNode::onAttach(Attach::Request& request, Attach::Response& response)
   const std::optional<int> node = world_->nearestFreeNode(*origin, request.body, request.radius);
   if (!node)
     return refuse("no free node" + (request.body.empty() ? std::string() : " of '" + request.body + "'") + " within " +
-                  std::to_string(request.radius) + " m of '" + request.frame + "'");
+                  formatNumber(request.radius) + " m of '" + request.frame + "'");
   const int anchor = world_->attach(*node, request.frame);
   followFrame(anchor, request.frame);
   const Anchor& made = world_->model().anchors[static_cast<std::size_t>(anchor)];
@@ -426,6 +416,7 @@ bool SimNode::onDetach(Detach::Request& request, Detach::Response& response)
     ROS_WARN("%s: detach refused: %s", name_.c_str(), why.c_str());
     return true;
   };
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("detach"));
   if (request.frame.empty())
     return refuse("no frame given");
   const std::string why = badName("frame name", request.frame);
@@ -453,6 +444,7 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
     ROS_WARN("%s: grasp refused: %s", name_.c_str(), why.c_str());
     return true;
   };
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("grasp"));
   if (request.frame.empty())
     return refuse("no frame given");
   if (request.body.empty())
@@ -461,7 +453,7 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
     if (!why.empty())
       return refuse(why);
   if (!(request.max_force >= 0.0 && std::isfinite(request.max_force)))
-    return refuse("max_force must be a finite number >= 0 [N] (0: no limit), not " + std::to_string(request.max_force));
+    return refuse("max_force must be a finite number >= 0 [N] (0: no limit), not " + formatNumber(request.max_force));
   std::string unusable;
   const std::optional<RigidPose> pose = framePose(request.frame, ros::Time(0), &unusable);
   if (!pose)
@@ -484,13 +476,14 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
   response.success = true;
   response.message = "'" + request.frame + "' holds " + std::to_string(grasp.nodes.size()) + " node(s) of '" +
                      request.body + "'" +
-                     (request.max_force > 0.0 ? " up to " + std::to_string(request.max_force) + " N" : std::string());
+                     (request.max_force > 0.0 ? " up to " + formatNumber(request.max_force) + " N" : std::string());
   ROS_INFO("%s: %s", name_.c_str(), response.message.c_str());
   return true;
 }
 
 bool SimNode::onRelease(Detach::Request& request, Detach::Response& response)
 {
+  request.frame = tfFrame(request.frame, private_nh_.resolveName("release"));
   const std::string why = request.frame.empty() ? "no frame given" : badName("frame name", request.frame);
   if (!why.empty() || !world_->release(request.frame))
   {

@@ -12,6 +12,9 @@ namespace soft_body_sim
 class SimNodelet : public nodelet::Nodelet
 {
 private:
+  /// What SimNode::initialize throws (a scene that fails to load, a bad parameter) is logged and thrown
+  /// on: nodelet's Loader::load catches it, drops the nodelet and fails the load, so that `nodelet load`
+  /// exits non-zero and a launch requiring it stops, as the node does.
   void onInit() override
   {
     node_ = std::make_unique<SimNode>(getNodeHandle(), getPrivateNodeHandle(), getName());
@@ -21,9 +24,9 @@ private:
     }
     catch (const std::exception& e)
     {
-      // A nodelet cannot stop its manager: say why it does nothing, and do nothing.
+      // Debian's nodelet (1.10) says only "Failed to initialize nodelet NAME", at debug level.
       NODELET_FATAL("%s", e.what());
-      node_.reset();
+      throw;
     }
   }
 

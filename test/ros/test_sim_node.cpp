@@ -20,10 +20,13 @@
 #include <std_srvs/Empty.h>
 #include <std_srvs/SetBool.h>
 #include <tf2_ros/static_transform_broadcaster.h>
+#include <visualization_msgs/InteractiveMarkerFeedback.h>
+#include <visualization_msgs/InteractiveMarkerUpdate.h>
 #include <visualization_msgs/MarkerArray.h>
 #include <xmlrpcpp/XmlRpcClient.h>
 
 #include "soft_body_sim/SimState.h"
+#include "soft_body_sim/ros/anchor_handles.h"
 #include "soft_body_sim/ros/ros_converter.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "wait_for.h"
@@ -257,6 +260,82 @@ TEST_F(SimNodeTest, AnAnchorPoseInAnotherFrameMovesTheNodeToTheTransformedPose)
   // Held there, exactly, while the rope swings below it.
   nextStates(5);
   EXPECT_LT((node(0) - expected).norm(), 1e-12);
+}
+
+TEST_F(SimNodeTest, AFrameIdWithALeadingSlashIsTakenWithoutItWithOneWarningPerTopic)
+{
+  const std::size_t from = warnings_.size();
+  const Vec3 expected(0.05, 0.02, 1.1);
+  // "/world" is the scene's frame "world": no transform, the node goes exactly there.
+  ASSERT_TRUE(waitFor(
+      [&] {
+        start_pub_.publish(pose("/world", expected.x(), expected.y(), expected.z()));
+        return node(0) == expected;
+      },
+      10.0));
+  nextStates(5);
+  EXPECT_EQ(node(0), expected);
+  const auto slash_warnings = [&] {
+    int count = 0;
+    for (std::size_t k = from; k < warnings_.size(); ++k)
+      count += warnings_[k].find("leading slash") != std::string::npos;
+    return count;
+  };
+  EXPECT_TRUE(waitFor([&] { return warned(from, { "/soft_body_sim/rope/start/pose", "leading slash" }); }, 10.0));
+  EXPECT_EQ(slash_warnings(), 1);
+}
+
+// The handles on their own (in this process, whose spinner serves their server): rviz, or anyone on
+// ~handles/feedback, may send a NaN pose, which interactive_markers' server takes for the handle's next
+// update before the callback sees it.
+TEST(AnchorHandlesTest, ANonFiniteFeedbackPoseIsNeitherPassedOnNorSentBackToClients)
+{
+  ros::NodeHandle nh;
+  const std::string ns = "/nan_test/handles";
+  AnchorHandles handles(ns, "world");
+  handles.add("a", "/nan_test/a/pose", Vec3(0.0, 0.0, 1.0));
+  handles.add("b", "/nan_test/b/pose", Vec3(1.0, 0.0, 1.0));
+  handles.applyChanges();
+  std::vector<geometry_msgs::Pose> sent;  // every pose on a's topic and in the server's updates
+  int updates_of_a = 0;
+  ros::Subscriber a_sub = nh.subscribe<geometry_msgs::PoseStamped>(
+      "/nan_test/a/pose", 10, [&](const geometry_msgs::PoseStamped::ConstPtr& p) { sent.push_back(p->pose); });
+  ros::Subscriber update_sub = nh.subscribe<visualization_msgs::InteractiveMarkerUpdate>(
+      ns + "/update", 100, [&](const visualization_msgs::InteractiveMarkerUpdate::ConstPtr& update) {
+        for (const visualization_msgs::InteractiveMarker& marker : update->markers)
+          sent.push_back(marker.pose);
+        for (const visualization_msgs::InteractiveMarkerPose& pose : update->poses)
+        {
+          sent.push_back(pose.pose);
+          updates_of_a += pose.name == "a";
+        }
+      });
+  ros::Publisher feedback_pub = nh.advertise<visualization_msgs::InteractiveMarkerFeedback>(ns + "/feedback", 10);
+  ASSERT_TRUE(waitFor([&] { return feedback_pub.getNumSubscribers() > 0 && update_sub.getNumPublishers() > 0; }, 10.0));
+  visualization_msgs::InteractiveMarkerFeedback feedback;
+  feedback.header.frame_id = "world";
+  feedback.client_id = "/test_sim_node/rviz";
+  feedback.marker_name = "a";
+  feedback.control_name = "move_3d";
+  feedback.event_type = visualization_msgs::InteractiveMarkerFeedback::POSE_UPDATE;
+  feedback.pose.position.x = std::numeric_limits<double>::quiet_NaN();
+  feedback.pose.orientation.w = 1.0;
+  feedback_pub.publish(feedback);
+  // As the node's ticks do: b follows its (moving) node and the batch goes out, until an update of a.
+  int tick = 0;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        handles.follow("b", Vec3(1.0 + 0.01 * ++tick, 0.0, 1.0));
+        handles.applyChanges();
+        return updates_of_a > 0;
+      },
+      10.0));
+  for (const geometry_msgs::Pose& pose : sent)
+  {
+    const Vec3 orientation(pose.orientation.x, pose.orientation.y, pose.orientation.z);
+    EXPECT_TRUE(RosConverter::toVec3(pose.position).allFinite() && orientation.allFinite() &&
+                std::isfinite(pose.orientation.w));
+  }
 }
 
 TEST_F(SimNodeTest, DraggingTheRopeEndDragsTheRope)

@@ -22,7 +22,8 @@ public:
   /// @param frame_id the scene's fixed frame, in which handles are placed and report their poses
   AnchorHandles(const std::string& topic_ns, const std::string& frame_id);
 
-  /// Adds a handle `name` at `position` [m] that publishes its poses (PoseStamped) on `topic`.
+  /// Adds a handle `name` at `position` [m] that publishes its poses (PoseStamped) on `topic`. A feedback
+  /// pose that is not finite is dropped with a throttled warning and the handle stays where it was.
   void add(const std::string& name, const std::string& topic, const Vec3& position);
 
   /// Moves handle `name` to where the simulation has it, unless it is being dragged; call applyChanges()
@@ -41,6 +42,7 @@ private:
   void onFeedback(const visualization_msgs::InteractiveMarkerFeedbackConstPtr& feedback);
 
   std::string frame_id_;
+  std::string server_topic_;  ///< the server's namespace, for log lines
   ros::NodeHandle nh_;
   interactive_markers::InteractiveMarkerServer server_;
   std::mutex mutex_;  ///< feedback arrives on the server's queue, follow() on the simulation's

@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -77,13 +78,16 @@ private:
   void applyDueInputs(const ros::Time& step_end);
   /// Warns (throttled) when an anchor input would move a rod's held end more than a segment per sub-step.
   void warnIfRodEndJumps(const ScheduledInput& input) const;
-  /// The pose's position in the scene frame, and if `orientation` is given its orientation there (nullopt
-  /// when the message's is all zeros, RosConverter::fromPose); false (with a throttled warning naming
-  /// `topic` and the reason) if it is not finite or its frame cannot be transformed.
+  /// The pose's position in the scene frame (its frame_id through tfFrame), and if `orientation` is given
+  /// its orientation there (nullopt when the message's is all zeros, RosConverter::fromPose); false (with a
+  /// throttled warning naming `topic` and the reason) if it is not finite or its frame cannot be transformed.
   bool toSceneFrame(const geometry_msgs::PoseStamped& pose, const std::string& topic, Vec3& position,
                     std::optional<Eigen::Quaterniond>* orientation = nullptr);
   /// Why a position [m] in the scene frame is no input the node takes (beyond ~workspace_radius), or empty.
   std::string outsideWorkspace(const Vec3& position) const;
+  /// `frame` without leading slashes ("/world" is "world": tf2 refuses the slash, which tf1 allowed and
+  /// many still write); warns the first time `source` (a topic, a service) sends one.
+  std::string tfFrame(const std::string& frame, const std::string& source);
   /// The pose of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf has
   /// none that recent yet); nullopt with a throttled warning if tf has none at all, or one that is not
   /// finite or beyond ~workspace_radius; `why`, if given, is set to the reason.
@@ -188,6 +192,7 @@ private:
     Vec3 start;          ///< [m]
   };
   std::vector<HeldNode> held_;  ///< as the current tick began
+  std::set<std::string> slash_warned_;  ///< sources warned about a frame name's leading slash (tfFrame)
   double force_scale_ = 0.02;     ///< ~force_scale [m/N]: length of the force arrows on ~force_markers
 };
 

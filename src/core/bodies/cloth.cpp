@@ -5,6 +5,7 @@
 #include <string>
 
 #include "soft_body_sim/core/bodies/rope.h"
+#include "soft_body_sim/core/format_number.h"
 
 namespace soft_body_sim
 {
@@ -96,7 +97,7 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
     // A node of radius r passes between four others of radius r at spacing d when d / sqrt(2) >= 2 r.
     requireDefinition(cloth.thickness >= 0.36 * spacing && cloth.thickness < 0.5 * spacing, what, { "thickness" },
                       "self_collision needs a thickness from 0.36 to 0.5 times the node spacing (" +
-                          std::to_string(spacing) + " m): thinner, a node slips between four others; thicker, "
+                          formatNumber(spacing) + " m): thinner, a node slips between four others; thicker, "
                           "neighbours overlap at rest");
   }
   requireSelfContact(what, cloth.self_collision, cloth.self_friction, cloth.thickness, "thickness");

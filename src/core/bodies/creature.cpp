@@ -9,6 +9,7 @@
 
 #include "core/bodies/fixed_period_clock.h"
 #include "soft_body_sim/core/bodies/rope.h"
+#include "soft_body_sim/core/format_number.h"
 
 namespace soft_body_sim
 {
@@ -232,8 +233,8 @@ BodyDef buildCreature(const std::string& name, const CreatureDef& def)
   // r < 1 and 0 < k T^2 < 2 (1 + r) (Jury's test); k = 0 or r = 1 is marginal (no spring / no drag).
   const double k_t2 = def.stiffness * def.update_period * def.update_period;
   check(k_t2 < 2.0 * (1.0 + def.lead_retention), { "stiffness", "update_period", "lead_retention" },
-        "stiffness * update_period^2 = " + std::to_string(k_t2) + " must be < 2 (1 + lead_retention) = " +
-            std::to_string(2.0 * (1.0 + def.lead_retention)) + " for the lead's recurrence to be stable");
+        "stiffness * update_period^2 = " + formatNumber(k_t2) + " must be < 2 (1 + lead_retention) = " +
+            formatNumber(2.0 * (1.0 + def.lead_retention)) + " for the lead's recurrence to be stable");
   check(def.anticipation >= 0.0, { "anticipation" }, "anticipation must be >= 0");
   check(def.settle_tolerance > 0.0, { "settle_tolerance" }, "settle_tolerance must be > 0");
   check(def.iterations >= 1 && def.iterations <= kMaxRelaxationPasses, { "iterations" },

@@ -7,6 +7,7 @@
 #include <Eigen/Geometry>  // cross products
 
 #include "core/bodies/fixed_period_clock.h"
+#include "soft_body_sim/core/format_number.h"
 
 namespace soft_body_sim
 {
@@ -171,8 +172,8 @@ BodyDef buildHumanoid(const std::string& name, const HumanoidDef& def)
   // The pelvis's recurrence is the creature lead's: stable for k T^2 < 2 (1 + r).
   const double k_t2 = def.torso_stiffness * def.limbs.frame_period * def.limbs.frame_period;
   check(k_t2 < 2.0 * (1.0 + def.torso_retention), { "torso_stiffness", "frame_period", "torso_retention" },
-        "torso_stiffness * frame_period^2 = " + std::to_string(k_t2) + " must be < 2 (1 + torso_retention) = " +
-            std::to_string(2.0 * (1.0 + def.torso_retention)) + " for the torso's recurrence to be stable");
+        "torso_stiffness * frame_period^2 = " + formatNumber(k_t2) + " must be < 2 (1 + torso_retention) = " +
+            formatNumber(2.0 * (1.0 + def.torso_retention)) + " for the torso's recurrence to be stable");
   check(def.up.norm() > 1e-12, { "up" }, "up must not be zero");
   check(def.facing.norm() > 1e-12, { "facing" }, "facing must not be zero");
   check(def.up.normalized().cross(def.facing.normalized()).norm() > 1e-9, { "facing", "up" },

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "soft_body_sim/core/bodies/cloth.h"
+#include "soft_body_sim/core/format_number.h"
 
 namespace soft_body_sim
 {
@@ -27,7 +28,7 @@ BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
         across.cross(down).norm() / std::max((across + down).norm(), (across - down).norm());
     requireDefinition(jelly.thickness <= 0.25 * clearance, what, { "thickness" },
                       "self_collision needs a thickness of at most a quarter of the distance from a cell's "
-                      "corner to its diagonal (" + std::to_string(clearance) + " m): thicker, its nodes start "
+                      "corner to its diagonal (" + formatNumber(clearance) + " m): thicker, its nodes start "
                       "less than two contact distances from the springs of their cells");
   }
   BodyDef body;

@@ -6,6 +6,7 @@
 
 #include "soft_body_sim/core/definition_error.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
+#include "soft_body_sim/core/format_number.h"
 
 namespace soft_body_sim
 {
@@ -84,8 +85,8 @@ void checkCollider(const Mesh& mesh)
   const double voxel = fieldVoxelSize(mesh);
   const double voxels = fieldVoxels(*mesh.triangles, voxel, 0.0);
   requireDefinition(voxels <= kMaxFieldVoxels, what, { "voxel_size" },
-                    "voxel_size " + std::to_string(voxel) + " m spans the mesh's bounding box with " +
-                        std::to_string(static_cast<long long>(voxels)) + " voxels, more than the " +
+                    "voxel_size " + formatNumber(voxel) + " m spans the mesh's bounding box with " +
+                        formatNumber(voxels) + " voxels, more than the " +
                         std::to_string(static_cast<long long>(kMaxFieldVoxels)) + " allowed; make it larger");
 }
 

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "soft_body_sim/core/elements/rods.h"
+#include "soft_body_sim/core/format_number.h"
 
 namespace soft_body_sim
 {
@@ -45,7 +46,7 @@ std::size_t GraspSet::grasp(Model& model, State& state, const std::string& name,
       g.offsets.push_back(to_frame * (state.position.col(i) - pose.position));
     }
   if (g.nodes.empty())
-    throw std::invalid_argument("no free node of body '" + body + "' within " + std::to_string(radius) + " m of the frame's origin");
+    throw std::invalid_argument("no free node of body '" + body + "' within " + formatNumber(radius) + " m of the frame's origin");
   // Pinned = inverse mass 0: from now on only the grasp moves them (Ten Minute Physics' grab).
   for (const int node : g.nodes)
     model.inverse_mass[node] = 0.0;
