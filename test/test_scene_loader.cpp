@@ -1384,7 +1384,7 @@ TEST(SceneLoader, MissingFileCannotBeOpened)
   }
   catch (const SceneError& e)
   {
-    EXPECT_EQ(std::string(e.what()), path + ": cannot open scene file");
+    EXPECT_EQ(std::string(e.what()), path + ": cannot open scene file: no such file");
   }
 }
 
@@ -1700,7 +1700,7 @@ TEST(SceneLoader, DirectoryCannotBeOpened)
   }
   catch (const SceneError& e)
   {
-    EXPECT_EQ(std::string(e.what()), sceneDir() + ": cannot open scene file");
+    EXPECT_EQ(std::string(e.what()), sceneDir() + ": cannot open scene file: it is a directory, not a regular file");
   }
 }
 

@@ -2,14 +2,15 @@
 
 #include <algorithm>
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <optional>
 #include <set>
 #include <utility>
 
 #include "scene/body_readers.h"
+#include "scene/listed_nodes_scan.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
+#include "soft_body_sim/core/input_file.h"
 #include "soft_body_sim/scene/mesh_uri.h"
 #include "scene/yaml_reader.h"
 
@@ -371,26 +372,28 @@ MeshFile readMeshFile(const Context& ctx, const Field& uri, const Vec3& scale)
 
 SceneDef loadSceneFile(const std::string& path)
 {
-  std::ifstream file(path);
-  std::string text;
-  try
-  {
-    if (file)
-      text.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
-  }
-  catch (const std::ios_base::failure&)  // e.g. a directory: it opens, but reading it throws
-  {
-    file.setstate(std::ios_base::badbit);
-  }
-  if (!file || file.bad())
+  const std::string unreadable = unreadableFileReason(path, kMaxSceneFileBytes, "kMaxSceneFileBytes");
+  if (!unreadable.empty())
+    throw SceneError(escapeControlCharacters(path + ": cannot open scene file: " + unreadable));
+  std::ifstream file(path, std::ios::binary | std::ios::ate);
+  const std::streamoff bytes = file.tellg();
+  if (!file || bytes < 0 || !file.seekg(0))
     throw SceneError(escapeControlCharacters(path) + ": cannot open scene file");
+  // Read into a string of the file's size: one copy of it in memory, where growing a string as it is read
+  // would hold up to two.
+  std::string text(static_cast<std::size_t>(bytes), '\0');
+  file.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (file.bad())
+    throw SceneError(escapeControlCharacters(path) + ": cannot open scene file");
+  text.resize(static_cast<std::size_t>(file.gcount()));
   return parseScene(text, path);
 }
 
 SceneDef parseScene(const std::string& yaml_text, const std::string& source, const SceneLimits& limits)
 {
   const Context ctx(source);
-  const YAML::Node root = loadSingleDocument(ctx, yaml_text);
+  ListedNodesScan scan(ctx);
+  const YAML::Node root = loadSingleDocument(ctx, yaml_text, scan);
   return readScene(ctx, Field{ root, "", root.Mark() }, limits);
 }
 

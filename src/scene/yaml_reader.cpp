@@ -6,7 +6,8 @@
 #include <cmath>
 #include <optional>
 #include <set>
-#include <sstream>
+#include <istream>
+#include <streambuf>
 
 #include <yaml-cpp/eventhandler.h>
 
@@ -18,35 +19,71 @@ namespace
 bool isQuoted(const YAML::Node& node) { return node.Tag() == "!"; }
 
 /// Where the last document of a stream started and the mark of its root node unless that is null,
-/// from the parser's events, without building the document.
+/// from the parser's events, without building the document. The first document's events also go to
+/// `first`.
 class DocumentOutline : public YAML::EventHandler
 {
 public:
   YAML::Mark start;
   std::optional<YAML::Mark> root;
 
+  explicit DocumentOutline(YAML::EventHandler& first) : first_(&first) {}
+
   void OnDocumentStart(const YAML::Mark& mark) override
   {
     start = mark;
     root.reset();
+    if (first_)
+      first_->OnDocumentStart(mark);
   }
-  void OnDocumentEnd() override {}
-  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { node(mark); }
-  void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string&) override
+  void OnDocumentEnd() override
+  {
+    if (first_)
+      first_->OnDocumentEnd();
+    first_ = nullptr;
+  }
+  void OnNull(const YAML::Mark& mark, YAML::anchor_t anchor) override
+  {
+    if (first_)
+      first_->OnNull(mark, anchor);
+  }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override
   {
     node(mark);
+    if (first_)
+      first_->OnAlias(mark, anchor);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override
+  void OnScalar(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                const std::string& value) override
   {
     node(mark);
+    if (first_)
+      first_->OnScalar(mark, tag, anchor, value);
   }
-  void OnSequenceEnd() override {}
-  void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override
+  void OnSequenceStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value style) override
   {
     node(mark);
+    if (first_)
+      first_->OnSequenceStart(mark, tag, anchor, style);
   }
-  void OnMapEnd() override {}
+  void OnSequenceEnd() override
+  {
+    if (first_)
+      first_->OnSequenceEnd();
+  }
+  void OnMapStart(const YAML::Mark& mark, const std::string& tag, YAML::anchor_t anchor,
+                  YAML::EmitterStyle::value style) override
+  {
+    node(mark);
+    if (first_)
+      first_->OnMapStart(mark, tag, anchor, style);
+  }
+  void OnMapEnd() override
+  {
+    if (first_)
+      first_->OnMapEnd();
+  }
 
 private:
   /// The first node of a document is its root; the others are inside it.
@@ -54,6 +91,20 @@ private:
   {
     if (!root)
       root = mark;
+  }
+
+  YAML::EventHandler* first_;  ///< until the first document ends
+};
+
+/// `text` as an input stream without the copy std::istringstream makes of it (a scene file may be
+/// kMaxSceneFileBytes). The parser only reads it.
+class TextStream : private std::streambuf, public std::istream
+{
+public:
+  explicit TextStream(const std::string& text) : std::istream(static_cast<std::streambuf*>(this))
+  {
+    char* const begin = const_cast<char*>(text.data());
+    setg(begin, begin, begin + text.size());
   }
 };
 
@@ -72,13 +123,13 @@ private:
 /// parser then reports an empty document without consuming the token, again and again, and LoadAll
 /// collects them until memory runs out. So the stream is first walked document by document, stopping at
 /// the first document that starts where the one before started; the first document is then built alone.
-YAML::Node loadSingleDocument(const Context& ctx, const std::string& text)
+YAML::Node loadSingleDocument(const Context& ctx, const std::string& text, YAML::EventHandler& scan)
 {
   try
   {
-    std::istringstream stream(text);
+    TextStream stream(text);
     YAML::Parser parser(stream);
-    DocumentOutline outline;
+    DocumentOutline outline(scan);
     std::optional<YAML::Mark> previous_start;
     for (; parser.HandleNextDocument(outline); previous_start = outline.start)
     {
@@ -93,7 +144,8 @@ YAML::Node loadSingleDocument(const Context& ctx, const std::string& text)
       if (previous_start && outline.root)
         ctx.fail(*outline.root, "", "found a second YAML document; a scene file holds exactly one");
     }
-    return YAML::Load(text);
+    TextStream document(text);
+    return YAML::Load(document);
   }
   catch (const YAML::ParserException& e)
   {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include "soft_body_sim/core/model.h"
@@ -63,8 +64,10 @@ private:
 };
 
 /// The first document of `text`, its one document that may hold anything (a trailing empty one may
-/// follow). Invalid YAML fails as "<source>:<line>:<column>: invalid YAML: <reason>".
-YAML::Node loadSingleDocument(const Context& ctx, const std::string& text);
+/// follow). Invalid YAML fails as "<source>:<line>:<column>: invalid YAML: <reason>". `scan` is told
+/// every event of the first document before yaml-cpp builds it, so that it can refuse the document (with
+/// a SceneError) before the tree takes its memory.
+YAML::Node loadSingleDocument(const Context& ctx, const std::string& text, YAML::EventHandler& scan);
 
 /// A mapping (any keys).
 void requireMapping(const Context& ctx, const Field& field);

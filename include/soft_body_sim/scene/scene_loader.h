@@ -2,6 +2,7 @@
 // the ROS node both load scenes through it, so they share one set of error messages.
 #pragma once
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -17,7 +18,16 @@ public:
   using std::runtime_error::runtime_error;
 };
 
-/// Loads and validates a scene file; throws SceneError.
+/// The largest scene file read [bytes]: 64 MiB, the largest scene the node limit allows written out in
+/// YAML, with margin. Only a custom body's listed nodes make a file big (every other body type is a few
+/// keys however many nodes it has), and kMaxSceneNodes of them, one `- {position: [0.125, -2.5, 1.75],
+/// mass: 0.001}` each, take ~50 MB. A larger file is refused by its size before it is read.
+constexpr std::uintmax_t kMaxSceneFileBytes = std::uintmax_t{ 64 } << 20;
+
+/// Loads and validates a scene file; throws SceneError. The file must be a regular file (a FIFO, a
+/// directory or a device is refused before it is opened) of at most kMaxSceneFileBytes, and the custom
+/// bodies' `nodes` lists are counted against kMaxSceneNodes by a scan of the YAML events, before
+/// yaml-cpp builds its tree of the document (~480 bytes a value: 70 times the text of a node list).
 SceneDef loadSceneFile(const std::string& path);
 
 /// What a scene may ask for beyond the fixed limits (kMaxSceneNodes), refused at the key that asks.

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "soft_body_sim/core/definition_error.h"
+#include "soft_body_sim/core/input_file.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
 
 namespace soft_body_sim
@@ -36,6 +37,10 @@ double TriangleMesh::boundingRadius() const
 
 TriangleMesh readTriangleMesh(const std::string& path, const Eigen::Vector3d& scale)
 {
+  const std::string what = "mesh file '" + path + "'";
+  // Before assimp opens it: its open of a FIFO blocks until a writer comes, and it reads any file whole.
+  const std::string unreadable = unreadableFileReason(path, kMaxMeshFileBytes, "kMaxMeshFileBytes");
+  requireDefinition(unreadable.empty(), what, { "mesh" }, "cannot be read: " + unreadable);
   Assimp::Importer importer;
   // Only positions matter: without normals and texture coordinates, JoinIdenticalVertices merges the
   // corners that faces share (an STL repeats them per face), so the mesh is one connected surface.
@@ -47,7 +52,6 @@ TriangleMesh readTriangleMesh(const std::string& path, const Eigen::Vector3d& sc
   const aiScene* scene =
       importer.ReadFile(path, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_SortByPType |
                                   aiProcess_PreTransformVertices | aiProcess_JoinIdenticalVertices);
-  const std::string what = "mesh file '" + path + "'";
   requireDefinition(scene != nullptr, what, { "mesh" }, std::string("cannot be read: ") + importer.GetErrorString());
   TriangleMesh mesh;
   for (unsigned int m = 0; m < scene->mNumMeshes; ++m)

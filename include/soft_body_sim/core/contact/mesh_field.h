@@ -3,6 +3,7 @@
 // stay inside mesh_field.cpp: they are slow to compile, and no other file needs them.
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,9 +30,19 @@ struct TriangleMesh
 /// The triangles of every mesh in the file at `path` (STL, COLLADA, OBJ and the other formats assimp
 /// reads), joined in the file's frame with the file's node transforms applied, polygons triangulated,
 /// identical vertices merged, and every vertex multiplied by `scale` per axis. Units are the file's,
-/// taken as metres. Throws DefinitionError at the key "mesh" naming the path and assimp's reason if the
-/// file cannot be read or holds no triangle.
+/// taken as metres. Throws DefinitionError at the key "mesh" naming the path and the reason if the file
+/// is not a regular file (a FIFO, a directory, a device: refused by its status, never opened), is larger
+/// than kMaxMeshFileBytes (refused before it is read), cannot be read by assimp or holds no triangle.
 TriangleMesh readTriangleMesh(const std::string& path, const Eigen::Vector3d& scale);
+
+/// The largest mesh file read [bytes]: 256 MiB. assimp reads a file whole into memory before it parses it,
+/// so a larger one (a 3 GB sparse file reads as 3 GB of zeros) would take its size in memory only to be
+/// refused. The number is the finest mesh our limits can use, in the most verbose format: a field of
+/// kMaxFieldVoxels = 256^3 voxels resolves a closed surface to about one triangle pair per voxel face on
+/// its bounding box, 6 256^2 2 ~ 8 10^5 triangles, and ASCII STL spends ~260 bytes on a triangle (a
+/// `facet normal` line, `outer loop`, three `vertex` lines, `endloop`, `endfacet`), ~210 MB; binary STL
+/// takes 50 bytes a triangle.
+constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t{ 256 } << 20;
 
 /// The largest extent [m] of `mesh`'s bounding box, over `kDefaultVoxelsPerExtent`: the voxel size of a
 /// mesh collider that sets none.
