@@ -228,7 +228,8 @@ TEST(SceneFileLimits, ListedNodesOverTheNodeLimitAreRefusedBeforeTheTreeIsBuilt)
   const ChildLoad load = loadInChild(path);
   ASSERT_TRUE(load.finished) << "the load did not finish in " << kTimeout << " s";
   EXPECT_TRUE(startsWith(load.error, path + ":4: bodies[0].nodes: ")) << load.error;
-  EXPECT_TRUE(contains(load.error, "more than " + std::to_string(kMaxSceneNodes) + " nodes")) << load.error;
+  EXPECT_TRUE(contains(load.error, "nodes")) << load.error;
+  EXPECT_TRUE(contains(load.error, "more than " + std::to_string(kMaxSceneNodes))) << load.error;
   EXPECT_LT(load.added_bytes, 2 * bytes) << load.error;
 }
 

@@ -1,21 +1,10 @@
 #include "soft_body_sim/core/input_file.h"
 
-#include <cstdio>
 #include <filesystem>
 #include <system_error>
 
 namespace soft_body_sim
 {
-namespace
-{
-std::string printed(double value)
-{
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-}  // namespace
-
 std::string unreadableFileReason(const std::string& path, std::uintmax_t max_bytes, const std::string& limit_name)
 {
   namespace fs = std::filesystem;
@@ -45,8 +34,8 @@ std::string unreadableFileReason(const std::string& path, std::uintmax_t max_byt
   if (error)
     return error.message();
   if (bytes > max_bytes)
-    return "it is " + printed(static_cast<double>(bytes)) + " bytes, more than the " +
-           printed(static_cast<double>(max_bytes)) + " such a file may have (" + limit_name + ")";
+    return "it is " + std::to_string(bytes) + " bytes, more than the " + std::to_string(max_bytes) +
+           " such a file may have (" + limit_name + ")";
   return "";
 }
 
