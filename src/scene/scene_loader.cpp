@@ -377,7 +377,7 @@ SceneDef loadSceneFile(const std::string& path)
     throw SceneError(escapeControlCharacters(path + ": cannot open scene file: " + unreadable));
   std::ifstream file(path, std::ios::binary | std::ios::ate);
   const std::streamoff bytes = file.tellg();
-  if (!file || bytes < 0 || !file.seekg(0))
+  if (!file || bytes < 0 || static_cast<std::uintmax_t>(bytes) > kMaxSceneFileBytes || !file.seekg(0))
     throw SceneError(escapeControlCharacters(path) + ": cannot open scene file");
   // Read into a string of the file's size: one copy of it in memory, where growing a string as it is read
   // would hold up to two.
