@@ -16,6 +16,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -210,27 +211,44 @@ TEST(SceneFileLimits, ADirectoryAsAMeshIsRefused)
   EXPECT_TRUE(contains(load.error, "directory")) << load.error;
 }
 
+/// `nodes` items "*n" (an alias of one node, 4 bytes each), `count` of them after the anchor `&n`.
+std::string aliasedNodes(long long count)
+{
+  std::string text = "[&n {position: [0, 0, 0], mass: 1}";
+  for (long long node = 1; node < count; ++node)
+    text += node % 16 == 0 ? ",\n      *n" : ", *n";
+  return text + "]";
+}
+
 TEST(SceneFileLimits, ListedNodesOverTheNodeLimitAreRefusedBeforeTheTreeIsBuilt)
 {
-  // Just under the size limit: one more node than a scene may have, as aliases of one node (4 bytes
-  // each), then a comment up to the limit.
+  // One more node than a scene may have, listed in one body, or in a list that a second body names by
+  // its anchor; then a comment up to the size limit, so that the file is as large as a scene file may be.
+  const long long half = kMaxSceneNodes / 2 + 1;
+  const std::string one_list = "bodies:\n  - name: blob\n    type: custom\n    nodes: " +
+                               aliasedNodes(kMaxSceneNodes + 1) + "\n";
+  const std::string shared_list = "bodies:\n  - name: blob\n    type: custom\n    nodes: &half " +
+                                  aliasedNodes(half) + "\n  - name: twin\n    type: custom\n    nodes: *half\n";
+  const std::size_t twin_nodes = shared_list.find("nodes: *half");
+  const std::string twin_line = std::to_string(1 + std::count(shared_list.begin(), shared_list.begin() + twin_nodes, '\n'));
   const TempFolder folder;
-  const std::string path = folder / "many_nodes.yaml";
-  std::string text = "bodies:\n  - name: blob\n    type: custom\n    nodes: [&n {position: [0, 0, 0], mass: 1}";
-  for (long long node = 1; node <= kMaxSceneNodes; ++node)
-    text += node % 16 == 0 ? ",\n      *n" : ", *n";
-  text += "]\n#";
-  text.resize(static_cast<std::size_t>(kMaxSceneFileBytes) - 1, 'x');
-  writeFile(path, text + "\n");
-  const long bytes = static_cast<long>(fs::file_size(path));
-  text.clear();
-  text.shrink_to_fit();
-  const ChildLoad load = loadInChild(path);
-  ASSERT_TRUE(load.finished) << "the load did not finish in " << kTimeout << " s";
-  EXPECT_TRUE(startsWith(load.error, path + ":4: bodies[0].nodes: ")) << load.error;
-  EXPECT_TRUE(contains(load.error, "nodes")) << load.error;
-  EXPECT_TRUE(contains(load.error, "more than " + std::to_string(kMaxSceneNodes))) << load.error;
-  EXPECT_LT(load.added_bytes, 2 * bytes) << load.error;
+  for (const auto& [text, location] : { std::make_pair(one_list, std::string(":4: bodies[0].nodes: ")),
+                                        std::make_pair(shared_list, ":" + twin_line + ": bodies[1].nodes: ") })
+  {
+    const std::string path = folder / "many_nodes.yaml";
+    {
+      std::string padded = text + "#";
+      padded.resize(static_cast<std::size_t>(kMaxSceneFileBytes) - 1, 'x');
+      writeFile(path, padded + "\n");
+    }
+    const long bytes = static_cast<long>(fs::file_size(path));
+    const ChildLoad load = loadInChild(path);
+    ASSERT_TRUE(load.finished) << "the load did not finish in " << kTimeout << " s";
+    EXPECT_TRUE(startsWith(load.error, path + location)) << load.error;
+    EXPECT_TRUE(contains(load.error, "nodes")) << load.error;
+    EXPECT_TRUE(contains(load.error, "more than " + std::to_string(kMaxSceneNodes))) << load.error;
+    EXPECT_LT(load.added_bytes, 2 * bytes) << load.error;
+  }
 }
 
 }  // namespace

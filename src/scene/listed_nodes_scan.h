@@ -25,17 +25,19 @@ public:
   void OnDocumentStart(const YAML::Mark&) override {}
   void OnDocumentEnd() override {}
   void OnNull(const YAML::Mark& mark, YAML::anchor_t) override { value(mark, nullptr); }
-  void OnAlias(const YAML::Mark& mark, YAML::anchor_t) override { value(mark, nullptr); }
+  void OnAlias(const YAML::Mark& mark, YAML::anchor_t anchor) override;
   void OnScalar(const YAML::Mark& mark, const std::string&, YAML::anchor_t, const std::string& text) override
   {
     value(mark, &text);
   }
-  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override
+  void OnSequenceStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t anchor,
+                       YAML::EmitterStyle::value) override
   {
     value(mark, nullptr);
     levels_.emplace_back(false);
+    levels_.back().anchor = anchor;
   }
-  void OnSequenceEnd() override { levels_.pop_back(); }
+  void OnSequenceEnd() override;
   void OnMapStart(const YAML::Mark& mark, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override
   {
     value(mark, nullptr);
@@ -53,15 +55,25 @@ private:
     bool at_key = true;  ///< a mapping's next value is a key
     std::string key;     ///< a mapping's last key, if it was a scalar
     YAML::Mark key_mark;
-    int items = 0;  ///< a sequence's items so far
+    long long items = 0;       ///< a sequence's items so far
+    YAML::anchor_t anchor = 0;  ///< a sequence's anchor (`&name`), 0 without one
   };
 
   /// A value starts (a scalar's `text` given) inside the innermost open level.
   void value(const YAML::Mark& mark, const std::string* text);
+  /// Whether the innermost open level is the list of nodes at bodies[i].nodes.
+  bool inNodeList() const;
+  /// Whether the next value is the one at bodies[i].nodes.
+  bool atNodeListKey() const;
+  /// Adds `count` nodes listed in bodies[i].nodes; fails if that takes the scene over kMaxSceneNodes.
+  void addNodes(long long count, const YAML::Mark& mark);
 
   const Context& ctx_;
   std::vector<Level> levels_;
   long long nodes_ = 0;
+  /// The item count of every anchored sequence, by anchor: `nodes: *name` lists as many nodes as the
+  /// sequence `&name` holds (the tree shares it, yet the body copies it).
+  std::vector<long long> anchored_items_;
 };
 
 }  // namespace soft_body_sim::scene_yaml
