@@ -248,7 +248,6 @@ TEST(SceneFileLimits, ListedNodesOverTheNodeLimitAreRefusedBeforeTheTreeIsBuilt)
     EXPECT_TRUE(contains(load.error, "nodes")) << load.error;
     EXPECT_TRUE(contains(load.error, "more than " + std::to_string(kMaxSceneNodes))) << load.error;
     // The scan's words: refused from the parser's events, not by the body reader after the tree is built.
-    // (For the shared list, the tree of half a million aliases would take less memory than the text.)
     EXPECT_TRUE(contains(load.error, "listed in its custom bodies")) << load.error;
     EXPECT_LT(load.added_bytes, 2 * bytes) << load.error;
   }
