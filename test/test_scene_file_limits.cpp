@@ -152,8 +152,8 @@ TEST(SceneFileLimits, ASceneFileOverTheSizeLimitIsRefusedUnread)
   ASSERT_TRUE(load.finished) << "the load did not finish in " << kTimeout << " s";
   EXPECT_TRUE(startsWith(load.error, path + ": cannot open scene file: ")) << load.error;
   EXPECT_TRUE(contains(load.error, "kMaxSceneFileBytes")) << load.error;
-  // Refused by its size before it is read, so not even one copy of it is in memory (the issue allows 2x;
-  // one read of it alone takes 1x).
+  // Refused by its size before it is read, so not even one copy of it is in memory (reading it would
+  // take its size at least).
   EXPECT_LT(load.added_bytes, static_cast<long>(bytes / 4)) << load.error;
 }
 

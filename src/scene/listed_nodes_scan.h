@@ -15,8 +15,9 @@
 namespace soft_body_sim::scene_yaml
 {
 /// Counts the items of every `bodies[i].nodes` list (a custom body's nodes; a rod's `nodes` is a number,
-/// and a list under another type's is refused later anyway) and fails at the list that takes the count over kMaxSceneNodes. The full
-/// check, with the generated bodies' nodes, is SceneSoFar::requireNodes once the document is read.
+/// and a list under another type's is refused later anyway) and fails at the list that takes the count
+/// over kMaxSceneNodes. The full check, with the generated bodies' nodes, is SceneSoFar::requireNodes
+/// once the document is read.
 class ListedNodesScan : public YAML::EventHandler
 {
 public:
