@@ -39,8 +39,8 @@ TriangleMesh readTriangleMesh(const std::string& path, const Eigen::Vector3d& sc
 /// so a larger one (a 3 GB sparse file reads as 3 GB of zeros) would take its size in memory only to be
 /// refused. The number is the finest mesh our limits can use, in the most verbose format: a field of
 /// kMaxFieldVoxels = 256^3 voxels resolves a closed surface to about one triangle pair per voxel face on
-/// its bounding box, 6 256^2 2 ~ 8 10^5 triangles, and ASCII STL spends ~260 bytes on a triangle (a
-/// `facet normal` line, `outer loop`, three `vertex` lines, `endloop`, `endfacet`), ~210 MB; binary STL
+/// its bounding box, 6 256^2 2 ~ 8 10^5 triangles, and ASCII STL spends ~250 bytes on a triangle (a
+/// `facet normal` line, `outer loop`, three `vertex` lines, `endloop`, `endfacet`), ~200 MB; binary STL
 /// takes 50 bytes a triangle.
 constexpr std::uintmax_t kMaxMeshFileBytes = std::uintmax_t{ 256 } << 20;
 
