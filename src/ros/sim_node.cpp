@@ -201,15 +201,12 @@ void SimNode::advance(const ros::Time& now, double elapsed)
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (taken > 0)
     statistics_.wall_seconds_per_step = wall / static_cast<double>(taken);
+  // The steps not taken stay due: the next tick takes them. A passing slow tick (the machine busy for a
+  // moment) is caught up without moving the start time, which would make the run unreplayable; a node
+  // that cannot keep real time reaches the two ticks' cap above, which drops the backlog beyond it, and
+  // under /use_sim_time (no cap) a replay takes every step, only later.
   if (taken < steps)
-  {
     warnOverBudget(steps, taken, wall);
-    // In wall-clock time the steps not taken are dropped, as when falling behind: the next tick starts
-    // from now, and a node that cannot keep real time never builds a backlog. Under /use_sim_time they
-    // stay due: the next tick takes them, so that a replay takes every step, only later.
-    if (!ros::Time::isSimTime())
-      epoch_ += ros::Duration(static_cast<double>(steps - taken) * dt);
-  }
   steps = taken;
   // Whole steps per tick alternate (e.g. 3 and 4 steps of 5 ms in 16.7 ms ticks): the real-time factor
   // is taken over windows of at least half a second.
@@ -227,17 +224,13 @@ void SimNode::warnOverBudget(long steps, long taken, double wall) const
   const double dt = world_->settings().dt;
   // The pace of this tick's stepping: simulated seconds per wall second.
   const double factor = static_cast<double>(taken) * dt / wall;
-  if (ros::Time::isSimTime())
-    ROS_WARN_THROTTLE(5.0,
-                      "%s: a tick ran out of ~tick_budget = %g s after %ld of %ld steps (real-time factor %.3g): "
-                      "the other steps follow in the next ticks, behind /clock; slow the clock down to keep pace",
-                      name_.c_str(), tick_budget_, taken, steps, factor);
-  else
-    ROS_WARN_THROTTLE(5.0,
-                      "%s: a tick ran out of ~tick_budget = %g s after %ld of %ld steps (real-time factor %.3g): "
-                      "%g s of simulation dropped; lower substeps or iterations, raise dt, or run under "
-                      "/use_sim_time with a slower clock",
-                      name_.c_str(), tick_budget_, taken, steps, factor, static_cast<double>(steps - taken) * dt);
+  ROS_WARN_THROTTLE(5.0,
+                    "%s: a tick ran out of ~tick_budget = %g s after %ld of %ld steps (real-time factor %.3g): the "
+                    "rest follow in the next ticks%s",
+                    name_.c_str(), tick_budget_, taken, steps, factor,
+                    ros::Time::isSimTime() ? ", behind /clock; slow the clock down to keep pace" :
+                                             "; beyond two ticks' worth behind, time is dropped: lower substeps or "
+                                             "iterations, raise dt, or run under /use_sim_time with a slower clock");
 }
 
 void SimNode::publish()

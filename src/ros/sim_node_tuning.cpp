@@ -102,7 +102,8 @@ void SimNode::warnIfSlowerThanRealTime(const StepSettings& settings) const
            "at most %.3g; each tick stops stepping after ~tick_budget = %g s and %s",
            name_.c_str(), settings.dt, settings.substeps, settings.iterations, estimate, cost, now.dt, now.substeps,
            now.iterations, factor, tick_budget_,
-           ros::Time::isSimTime() ? "the other steps follow later, behind /clock" : "the time left is dropped");
+           ros::Time::isSimTime() ? "the other steps follow later, behind /clock"
+                                  : "beyond two ticks' worth behind, simulated time is dropped");
 }
 
 std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& config)

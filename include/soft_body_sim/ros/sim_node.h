@@ -52,8 +52,7 @@ private:
   // --- time (sim_node.cpp)
   void onTimer(const ros::TimerEvent& event);
   /// Simulates whole steps up to `now`, at most max_steps_per_tick_ of them (no cap under /use_sim_time),
-  /// and none begun after tick_budget_ of wall time: in wall-clock time the steps left are dropped, under
-  /// /use_sim_time they wait for the next tick.
+  /// and none begun after tick_budget_ of wall time: the steps left wait for the next tick.
   void advance(const ros::Time& now, double elapsed);
   /// Warns (throttled) that a tick ran out of tick_budget_ after `taken` of `steps` steps in `wall` [s].
   void warnOverBudget(long steps, long taken, double wall) const;
