@@ -63,5 +63,6 @@ class BudgetTest(NodeTestCase):
                         [m.msg for m in self.log[start:]])
         self.assertTrue(self.warned("ran out of ~tick_budget", start), [m.msg for m in self.log[start:]])
 
+
 if __name__ == "__main__":
     rostest.rosrun("soft_body_sim", "budget", BudgetTest)
