@@ -124,26 +124,24 @@ std::string SimNode::applyBodyConfig(const std::string& body, const BodyConfig& 
 void SimNode::noteHeldNodes()
 {
   held_.clear();
-  const Model& model = world_->model();
   const NodeArray& position = world_->state().position;
-  for (std::size_t b = 0; b < model.bodies.size(); ++b)
-    for (const Anchor& anchor : model.anchors)
-      if (anchor.body == model.bodies[b].name)
-        held_.push_back({ b, "anchor '" + anchor.name + "'", anchor.node, position.col(anchor.node) });
+  for (const Anchor& anchor : world_->model().anchors)
+    held_.push_back({ "anchor '" + anchor.name + "'", anchor.node, position.col(anchor.node) });
   for (const GraspedNodes& grasp : world_->grasps())
     for (const int node : grasp.nodes)
-      held_.push_back({ grasp.body, "grasp '" + grasp.name + "'", node, position.col(node) });
+      held_.push_back({ "grasp '" + grasp.name + "'", node, position.col(node) });
 }
 
 std::string SimNode::inputJump(std::size_t body) const
 {
+  const Model& model = world_->model();
   const NodeArray& position = world_->state().position;
   const HeldNode* largest = nullptr;
   double jump = 0.0;
   for (const HeldNode& held : held_)
   {
     const double moved = (position.col(held.node) - held.start).norm();
-    if (held.body == body && moved > jump)
+    if (model.bodyOf(held.node) == body && moved > jump)
     {
       jump = moved;
       largest = &held;
@@ -155,7 +153,7 @@ std::string SimNode::inputJump(std::size_t body) const
   // good. A hand carries a body less than its own size in one tick (1/60 s: 60 sizes per second); a pose
   // that leaps further is a jump in the input, and it is what drags the body's springs past what any step
   // resolves.
-  const BodyRange& range = world_->model().bodies[body];
+  const BodyRange& range = model.bodies[body];
   Eigen::AlignedBox3d box;
   for (int node = range.first; node < range.first + range.count; ++node)
     if (std::none_of(held_.begin(), held_.end(), [node](const HeldNode& held) { return held.node == node; }))

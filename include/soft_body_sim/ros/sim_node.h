@@ -185,7 +185,6 @@ private:
   /// A node held by an anchor or a grasp, where it was as the tick began.
   struct HeldNode
   {
-    std::size_t body;    ///< index into Model::bodies
     std::string holder;  ///< "anchor 'end'" or "grasp 'hand'"
     int node;            ///< global node index
     Vec3 start;          ///< [m]
