@@ -205,6 +205,9 @@ World buildWorld(const SceneDef& scene)
         node = globalIndex(body, first, node);
     for (const auto& [a, b] : body.contact_segments)
       model.contact_segments.emplace_back(globalIndex(body, first, a), globalIndex(body, first, b));
+    for (const std::array<int, 3>& triangle : body.contact_triangles)
+      model.contact_triangles.push_back({ globalIndex(body, first, triangle[0]), globalIndex(body, first, triangle[1]),
+                                          globalIndex(body, first, triangle[2]) });
     for (const AnchorDef& anchor : body.anchors)
     {
       const int node = globalIndex(body, first, anchor.node);

@@ -155,6 +155,9 @@ struct Model
   /// Segments that collide along their length (a rope's links), as global node index pairs; their
   /// radius is their nodes' contact radius.
   std::vector<std::pair<int, int>> contact_segments;
+  /// Triangles that meet colliders over their faces and edges (a cloth's; face_contacts.h), as global node
+  /// indices; their thickness is their nodes' mean contact radius.
+  std::vector<std::array<int, 3>> contact_triangles;
   std::vector<Spring> springs;
   std::vector<DistanceConstraint> constraints;
   std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then

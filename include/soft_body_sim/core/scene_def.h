@@ -84,6 +84,9 @@ struct BodyDef
   /// Pairs of node indices within the body whose segment collides as a whole (a rope's links), not
   /// only at its ends.
   std::vector<std::pair<int, int>> contact_segments;
+  /// Triangles of node indices within the body that collide with colliders over their faces and edges
+  /// (a cloth's two per grid square), not only at their corners.
+  std::vector<std::array<int, 3>> contact_triangles;
   /// Its contact segments (or, without any, its nodes as balls) keep apart from each other and from
   /// those of other such bodies (self_contacts.h); needs contact_radius > 0.
   bool self_collision = false;

@@ -113,6 +113,14 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   for (int index : cloth.pinned)
     body.nodes[static_cast<std::size_t>(resolveNodeIndex(index, nx * ny))].pinned = true;
   const auto node = [nx](int i, int j) { return j * nx + i; };
+  // Two triangles per square, split along the diagonal from (i, j) to (i + 1, j + 1), meet colliders
+  // over their faces and edges (face_contacts.h).
+  for (int j = 0; j + 1 < ny; ++j)
+    for (int i = 0; i + 1 < nx; ++i)
+    {
+      body.contact_triangles.push_back({ node(i, j), node(i + 1, j), node(i + 1, j + 1) });
+      body.contact_triangles.push_back({ node(i, j), node(i + 1, j + 1), node(i, j + 1) });
+    }
   if (cloth.bending)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)

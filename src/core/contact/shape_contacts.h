@@ -10,6 +10,7 @@
 
 #include "core/contact/closest_points.h"
 #include "core/contact/contact_response.h"
+#include "core/contact/face_contacts.h"
 #include "soft_body_sim/core/contact/contact_stage.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
 
@@ -81,6 +82,20 @@ inline double nearestParameter(const Mesh& mesh, const Vec3& la, const Vec3& d)
 /// The most a segment contact moves either node per unit of the contact point's correction.
 constexpr double kMaxLever = 2.0;
 
+/// Sweeps over a sub-step's touched contact triangles (the first over all of them). A cloth pressed by a
+/// finger between its nodes folds round it, and each triangle's push moves its neighbours: measured on a
+/// 5 cm cloth carried by a 1 cm finger at 2 m/s, one sweep left the finger through the cloth by the end
+/// under implicit_euler; four carried it.
+constexpr int kTrianglePasses = 4;
+
+/// The part of its thickness [-] that a triangle's face and edges keep from a shape (its nodes keep all of
+/// it). A cloth wrapped over a curved shape has its nodes on it and its faces, chords, inside by d^2 / 8R
+/// for a spacing d over a radius R: pushing them out to the full thickness lifts the nodes off at every
+/// sub-step and the draped cloth never comes to rest (measured: a 5 cm cloth on a 0.3 m ball still moving
+/// at 0.15 m/s after 6 s). So a face may sag into the contact distance by up to half its thickness: never
+/// into the shape.
+constexpr double kFaceSag = 0.5;
+
 template <typename Shape>
 class ShapeContacts final : public ColliderKind
 {
@@ -93,6 +108,7 @@ public:
       checkCollider(shape);
       shape.at.orientation.normalize();
       bounds_.push_back(boundingRadius(shape));
+      features_.push_back(shapeFeatures(shape));
       // A shape on a tf frame has no place in the scene until its frame's first pose lands.
       placed_.push_back(shape.at.frame.empty() ? 1 : 0);
     }
@@ -100,6 +116,13 @@ public:
 
   bool resolve(const Model& model, const NodeArray& start, State& state, double h) override
   {
+    if (!model.contact_triangles.empty())
+    {
+      placeFeatures(start_features_);
+      start_positions_.clear();
+      for (const Shape& shape : shapes_)
+        start_positions_.push_back(shape.at.position);
+    }
     move(h);
     const double resting_speed = restingSpeed(model.gravity, h);
     bool touched_any = false;
@@ -138,6 +161,20 @@ public:
     }
     for (const auto& [a, b] : model.contact_segments)
       touched_any = resolveSegment(model, start, state, h, a, b) || touched_any;
+    if (!model.contact_triangles.empty())
+    {
+      placeFeatures(features_now_);
+      sides_.resize(model.contact_triangles.size() * shapes_.size(), 0);
+      touched_triangles_.clear();
+      for (std::size_t t = 0; t < model.contact_triangles.size(); ++t)
+        if (resolveTriangle(model, start, state, h, t))
+          touched_triangles_.push_back(t);
+      // Pushing one triangle moves its neighbours' corners: the touched ones again, as Gauss-Seidel sweeps.
+      for (int pass = 1; pass < kTrianglePasses; ++pass)
+        for (const std::size_t t : touched_triangles_)
+          resolveTriangle(model, start, state, h, t);
+      touched_any = touched_any || !touched_triangles_.empty();
+    }
     return touched_any;
   }
 
@@ -278,6 +315,128 @@ private:
     return touched;
   }
 
+  /// A triangle of a surface against every shape's features (face_contacts.h), each contact shared by the
+  /// triangle's nodes by their weights at the point as resolveSegment shares it: the point moves by the
+  /// correction, and each node gets the impulse it would get if the contact were at that node, in
+  /// proportion to its weight.
+  bool resolveTriangle(const Model& model, const NodeArray& start, State& state, double h, std::size_t index)
+  {
+    const std::array<int, 3>& triangle = model.contact_triangles[index];
+    const double thickness = (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] +
+                              model.contact_radius[triangle[2]]) / 3.0;
+    const TriangleCorners then{ start.col(triangle[0]), start.col(triangle[1]), start.col(triangle[2]) };
+    bool touched = false;
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      if (!placed_[k] || features_[k].empty())
+        continue;
+      std::int8_t& side = sides_[index * shapes_.size() + k];
+      const auto corners = [&] {
+        return TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]),
+                                state.position.col(triangle[2]) };
+      };
+      if (!withinReach(k, corners(), then, thickness))
+      {
+        side = 0;
+        continue;
+      }
+      bool touched_shape = false;
+      for (std::size_t f = 0; f < features_[k].size(); ++f)
+      {
+        const std::optional<FaceTouch> touch =
+            faceTouch(features_now_[k][f], start_features_[k][f], corners(), then, thickness, kFaceSag * thickness, side);
+        if (touch)
+          touched_shape = pushTriangle(model, start, state, h, triangle, *touch, shapes_[k].at) || touched_shape;
+      }
+      if (!touched_shape)
+        side = sideOf(features_now_[k], corners());
+      touched = touched || touched_shape;
+    }
+    return touched;
+  }
+
+  /// Whether shape k's bounding ball, widened by `thickness`, comes within the triangle's bounding ball
+  /// anywhere on their straight paths from the sub-step's start to its end (relative to each other).
+  bool withinReach(std::size_t k, const TriangleCorners& now, const TriangleCorners& then, double thickness) const
+  {
+    const Vec3 centre = (now[0] + now[1] + now[2]) / 3.0, centre_then = (then[0] + then[1] + then[2]) / 3.0;
+    double size = 0.0;
+    for (int c = 0; c < 3; ++c)
+      size = std::max({ size, (now[c] - centre).norm(), (then[c] - centre_then).norm() });
+    const Vec3 offset = centre - shapes_[k].at.position, offset_then = centre_then - start_positions_[k];
+    const Vec3 path = offset - offset_then;
+    const double length2 = path.squaredNorm();
+    const double s = length2 > 0.0 ? std::clamp(-offset_then.dot(path) / length2, 0.0, 1.0) : 0.0;
+    const double reach = bounds_[k] + size + thickness;
+    return (offset_then + s * path).squaredNorm() <= reach * reach;
+  }
+
+  /// The triangle's point of `touch` leaves the shape as a node would, the correction shared by its nodes.
+  bool pushTriangle(const Model& model, const NodeArray& start, State& state, double h,
+                    const std::array<int, 3>& triangle, const FaceTouch& touch, const ColliderPlacement& at)
+  {
+    double s = 0.0;
+    Vec3 x = Vec3::Zero(), v = Vec3::Zero(), x_start = Vec3::Zero();
+    for (int c = 0; c < 3; ++c)
+    {
+      const int node = triangle[c];
+      s += touch.weight[c] * touch.weight[c] * model.inverse_mass[node];
+      x += touch.weight[c] * state.position.col(node);
+      v += touch.weight[c] * state.velocity.col(node);
+      x_start += touch.weight[c] * start.col(node);
+    }
+    if (!(s > 0.0))
+      return false;
+    const Vec3 velocity = at.velocity + at.angular_velocity.cross(touch.contact - at.position);
+    const double approach = -(v - velocity).dot(touch.normal);
+    const Vec3 x0 = x, v0 = v;
+    leaveSurface({ touch.normal, velocity, at.friction, at.restitution }, touch.depth,
+                 approach > restingSpeed(model.gravity, h), h, x - x_start, x, v);
+    for (int c = 0; c < 3; ++c)
+    {
+      const int node = triangle[c];
+      const double share = std::min(touch.weight[c] * model.inverse_mass[node] / s, kMaxLever);
+      state.position.col(node) += share * (x - x0);
+      state.velocity.col(node) += share * (v - v0);
+    }
+    return true;
+  }
+
+  /// The side of triangle t (+1: along its normal (t1 - t0) x (t2 - t0), -1: against it) where the
+  /// feature nearest to its centre lies.
+  static std::int8_t sideOf(const std::vector<ShapeFeature>& features, const TriangleCorners& t)
+  {
+    const Vec3 centre = (t[0] + t[1] + t[2]) / 3.0;
+    double least = 1e300;
+    Vec3 nearest = centre;
+    for (const ShapeFeature& f : features)
+    {
+      const Vec3 d = f.b - f.a;
+      const double length2 = d.squaredNorm();
+      const Vec3 p = f.a + (length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0) * d;
+      if ((p - centre).squaredNorm() < least)
+      {
+        least = (p - centre).squaredNorm();
+        nearest = p;
+      }
+    }
+    return (t[1] - t[0]).cross(t[2] - t[0]).dot(nearest - centre) >= 0.0 ? 1 : -1;
+  }
+
+  /// Every shape's features in the scene frame, where the shapes are now (face_contacts.h), into `placed`.
+  void placeFeatures(std::vector<std::vector<ShapeFeature>>& placed) const
+  {
+    placed.resize(shapes_.size());
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      const ColliderPlacement& at = shapes_[k].at;
+      placed[k].clear();
+      for (const ShapeFeature& f : features_[k])
+        placed[k].push_back({ at.position + at.orientation * f.a, at.position + at.orientation * f.b, f.radius,
+                              f.flat_ends });
+    }
+  }
+
   /// Whether a segment of contact depth `depth` [m] whose node `node` (at `local`, in the shape's frame) is
   /// on the shape lies on it as the rope does: a rope wrapped over a curved surface has its nodes on it and
   /// its chords a little inside, by (R + r)(1 - cos(delta / 2)) for a bend delta per link over radius R;
@@ -310,6 +469,14 @@ private:
   std::vector<char> placed_;                     ///< per shape: has a pose in the scene (collides, is drawn)
   std::vector<double> bounds_;                   ///< per shape: boundingRadius [m]
   std::vector<std::uint8_t> touching_;  ///< per node: on one of these shapes after the last sub-step
+  std::vector<std::vector<ShapeFeature>> features_;  ///< per shape: its features in its own frame
+  /// per shape: its features in the scene frame at the start of the current sub-step and now
+  std::vector<std::vector<ShapeFeature>> start_features_, features_now_;
+  /// per contact triangle and shape: the side of the triangle the shape was on when they last came near
+  /// without touching (sideOf; 0: not near then)
+  std::vector<std::int8_t> sides_;
+  std::vector<std::size_t> touched_triangles_;  ///< contact triangles touched in this sub-step's first sweep
+  std::vector<Vec3> start_positions_;  ///< per shape: its origin at the start of the current sub-step [m]
 };
 
 }  // namespace soft_body_sim

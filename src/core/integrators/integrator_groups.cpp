@@ -128,6 +128,7 @@ void IntegratorGroups::rebuild(const Model& model)
     });
     m.colliders = Colliders{};
     m.contact_segments.clear();
+    m.contact_triangles.clear();
     groups_.push_back(std::move(group));
   }
 }
