@@ -343,6 +343,8 @@ private:
       bool touched_shape = false;
       for (std::size_t f = 0; f < features_[k].size(); ++f)
       {
+        if (!nearFeature(features_now_[k][f], start_features_[k][f], corners(), then, thickness))
+          continue;
         const std::optional<FaceTouch> touch =
             faceTouch(features_now_[k][f], start_features_[k][f], corners(), then, thickness, kFaceSag * thickness, side);
         if (touch)
@@ -369,6 +371,27 @@ private:
     const double s = length2 > 0.0 ? std::clamp(-offset_then.dot(path) / length2, 0.0, 1.0) : 0.0;
     const double reach = bounds_[k] + size + thickness;
     return (offset_then + s * path).squaredNorm() <= reach * reach;
+  }
+
+  /// Whether feature f (f_start at the sub-step's start) comes within its radius plus `thickness` of the
+  /// triangle's bounding ball on their straight paths through the sub-step, its point nearest to the
+  /// triangle's centre followed: a table's far edges are skipped without a closer look.
+  static bool nearFeature(const ShapeFeature& f, const ShapeFeature& f_start, const TriangleCorners& now,
+                          const TriangleCorners& then, double thickness)
+  {
+    const Vec3 centre = (now[0] + now[1] + now[2]) / 3.0, centre_then = (then[0] + then[1] + then[2]) / 3.0;
+    double size = 0.0;
+    for (int c = 0; c < 3; ++c)
+      size = std::max({ size, (now[c] - centre).norm(), (then[c] - centre_then).norm() });
+    const Vec3 d = f.b - f.a;
+    const double length2 = d.squaredNorm();
+    const double s = length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0;
+    const Vec3 offset = centre - (f.a + s * d), offset_then = centre_then - (f_start.a + s * (f_start.b - f_start.a));
+    const Vec3 path = offset - offset_then;
+    const double path2 = path.squaredNorm();
+    const double t = path2 > 0.0 ? std::clamp(-offset_then.dot(path) / path2, 0.0, 1.0) : 0.0;
+    const double reach = size + f.radius + thickness;
+    return (offset_then + t * path).squaredNorm() <= reach * reach;
   }
 
   /// The triangle's point of `touch` leaves the shape as a node would, the correction shared by its nodes.
