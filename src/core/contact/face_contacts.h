@@ -17,6 +17,7 @@
 // crossed within a sub-step, and ShapeContacts widens its search by the sub-step's motion to find it.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <optional>
@@ -24,6 +25,8 @@
 
 #include "core/contact/closest_points.h"
 #include "soft_body_sim/core/contact/colliders.h"
+#include <Eigen/Geometry>
+
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
@@ -88,6 +91,90 @@ inline std::vector<ShapeFeature> shapeFeatures(const Cylinder& cylinder)
 
 /// A mesh's surface is a distance field: its nodes meet it, its faces not yet.
 inline std::vector<ShapeFeature> shapeFeatures(const Mesh& /*mesh*/) { return {}; }
+
+/// Consecutive features of a shape [first, last) within `radius` [m] (their own radii included) of
+/// `centre` (in the shape's frame): a triangle beyond that skips them all (a cylinder's rims of 24 edges
+/// in arcs of 8, a box's twelve edges in two sets).
+struct FeatureGroup
+{
+  std::size_t first = 0;
+  std::size_t last = 0;
+  Vec3 centre;
+  double radius = 0.0;
+};
+
+/// The features in groups of up to kFeatureGroup, each about the middle of its endpoints' bounding box.
+constexpr std::size_t kFeatureGroup = 8;
+inline std::vector<FeatureGroup> featureGroups(const std::vector<ShapeFeature>& features)
+{
+  std::vector<FeatureGroup> groups;
+  for (std::size_t first = 0; first < features.size(); first += kFeatureGroup)
+  {
+    FeatureGroup group;
+    group.first = first;
+    group.last = std::min(features.size(), first + kFeatureGroup);
+    Eigen::AlignedBox3d box;
+    for (std::size_t f = group.first; f < group.last; ++f)
+    {
+      box.extend(features[f].a);
+      box.extend(features[f].b);
+    }
+    group.centre = box.center();
+    for (std::size_t f = group.first; f < group.last; ++f)
+      group.radius = std::max({ group.radius, (features[f].a - group.centre).norm() + features[f].radius,
+                                (features[f].b - group.centre).norm() + features[f].radius });
+    groups.push_back(group);
+  }
+  return groups;
+}
+
+/// A triangle's bounding ball at the sub-step's start and end: its centroids and the largest distance
+/// of a corner from its centroid at either.
+struct TriangleBall
+{
+  TriangleBall(const std::array<Vec3, 3>& now, const std::array<Vec3, 3>& then)
+    : centre((now[0] + now[1] + now[2]) / 3.0), centre_then((then[0] + then[1] + then[2]) / 3.0)
+  {
+    double size2 = 0.0;
+    for (int c = 0; c < 3; ++c)
+      size2 = std::max({ size2, (now[c] - centre).squaredNorm(), (then[c] - centre_then).squaredNorm() });
+    size = std::sqrt(size2);
+  }
+
+  /// Whether a point moving straight from p_then to p comes within `reach` [m] of the ball moving
+  /// straight from its start to its end (relative to each other).
+  bool meets(const Vec3& p, const Vec3& p_then, double reach) const
+  {
+    double gap2;
+    return meets(p, p_then, reach, gap2);
+  }
+
+  /// As above, with the least squared distance [m^2] between the point and the centre on the way.
+  bool meets(const Vec3& p, const Vec3& p_then, double reach, double& gap2) const
+  {
+    const Vec3 offset = centre - p, offset_then = centre_then - p_then;
+    const Vec3 path = offset - offset_then;
+    const double length2 = path.squaredNorm();
+    const double s = length2 > 0.0 ? std::clamp(-offset_then.dot(path) / length2, 0.0, 1.0) : 0.0;
+    const double within = reach + size;
+    gap2 = (offset_then + s * path).squaredNorm();
+    return gap2 <= within * within;
+  }
+
+  /// Whether feature f (f_then at the start), thickened by `thickness` [m] more, comes within the ball, its
+  /// point nearest to the ball's centre followed through the sub-step; `gap2` as for meets.
+  bool meetsSegment(const ShapeFeature& f, const ShapeFeature& f_then, double thickness, double& gap2) const
+  {
+    const Vec3 d = f.b - f.a;
+    const double length2 = d.squaredNorm();
+    const double s = length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0;
+    return meets(f.a + s * d, f_then.a + s * (f_then.b - f_then.a), f.radius + thickness, gap2);
+  }
+
+  Vec3 centre;
+  Vec3 centre_then;
+  double size = 0.0;
+};
 
 /// Where a triangle must move to clear a feature: its point sum_k weight_k x_k moves by `depth` [m] along
 /// the unit `normal`; `contact` is the point of the shape's surface that it touches [m].

@@ -96,6 +96,14 @@ constexpr int kTrianglePasses = 4;
 /// into the shape.
 constexpr double kFaceSag = 0.5;
 
+/// A feature of a shape that touched a contact triangle (ShapeContacts' repeated sweeps).
+struct TouchedFeature
+{
+  std::size_t triangle;  ///< in Model::contact_triangles
+  std::size_t shape;
+  std::size_t feature;
+};
+
 template <typename Shape>
 class ShapeContacts final : public ColliderKind
 {
@@ -109,6 +117,7 @@ public:
       shape.at.orientation.normalize();
       bounds_.push_back(boundingRadius(shape));
       features_.push_back(shapeFeatures(shape));
+      groups_.push_back(featureGroups(features_.back()));
       // A shape on a tf frame has no place in the scene until its frame's first pose lands.
       placed_.push_back(shape.at.frame.empty() ? 1 : 0);
     }
@@ -120,8 +129,12 @@ public:
     {
       placeFeatures(start_features_);
       start_positions_.clear();
+      start_orientations_.clear();
       for (const Shape& shape : shapes_)
+      {
         start_positions_.push_back(shape.at.position);
+        start_orientations_.push_back(shape.at.orientation);
+      }
     }
     move(h);
     const double resting_speed = restingSpeed(model.gravity, h);
@@ -164,16 +177,18 @@ public:
     if (!model.contact_triangles.empty())
     {
       placeFeatures(features_now_);
+      placeGroups(group_centres_now_, group_centres_then_);
+      boxTriangles(model, start, state.position);
       sides_.resize(model.contact_triangles.size() * shapes_.size(), 0);
-      touched_triangles_.clear();
+      touched_features_.clear();
       for (std::size_t t = 0; t < model.contact_triangles.size(); ++t)
-        if (resolveTriangle(model, start, state, h, t))
-          touched_triangles_.push_back(t);
-      // Pushing one triangle moves its neighbours' corners: the touched ones again, as Gauss-Seidel sweeps.
+        resolveTriangle(model, start, state, h, t);
+      // Pushing one triangle moves its neighbours' corners: the features that touched a triangle, again,
+      // as Gauss-Seidel sweeps.
       for (int pass = 1; pass < kTrianglePasses; ++pass)
-        for (const std::size_t t : touched_triangles_)
-          resolveTriangle(model, start, state, h, t);
-      touched_any = touched_any || !touched_triangles_.empty();
+        for (const TouchedFeature& touched : touched_features_)
+          touchFeature(model, start, state, h, touched);
+      touched_any = touched_any || !touched_features_.empty();
     }
     return touched_any;
   }
@@ -325,73 +340,79 @@ private:
     const double thickness = (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] +
                               model.contact_radius[triangle[2]]) / 3.0;
     const TriangleCorners then{ start.col(triangle[0]), start.col(triangle[1]), start.col(triangle[2]) };
+    const auto corners = [&] {
+      return TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]),
+                              state.position.col(triangle[2]) };
+    };
     bool touched = false;
+    std::optional<TriangleBall> ball;
     for (std::size_t k = 0; k < shapes_.size(); ++k)
     {
       if (!placed_[k] || features_[k].empty())
         continue;
       std::int8_t& side = sides_[index * shapes_.size() + k];
-      const auto corners = [&] {
-        return TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]),
-                                state.position.col(triangle[2]) };
-      };
-      if (!withinReach(k, corners(), then, thickness))
+      if (!triangle_boxes_[index].intersects(shape_boxes_[k]))
       {
         side = 0;
         continue;
       }
+      if (!ball)
+        ball.emplace(corners(), then);
       bool touched_shape = false;
-      for (std::size_t f = 0; f < features_[k].size(); ++f)
+      const ShapeFeature* nearest = nullptr;  // of those near the triangle
+      double least = 1e300;
+      for (std::size_t g = 0; g < groups_[k].size(); ++g)
       {
-        if (!nearFeature(features_now_[k][f], start_features_[k][f], corners(), then, thickness))
+        const FeatureGroup& group = groups_[k][g];
+        if (!ball->meets(group_centres_now_[k][g], group_centres_then_[k][g], group.radius + thickness))
           continue;
-        const std::optional<FaceTouch> touch =
-            faceTouch(features_now_[k][f], start_features_[k][f], corners(), then, thickness, kFaceSag * thickness, side);
-        if (touch)
-          touched_shape = pushTriangle(model, start, state, h, triangle, *touch, shapes_[k].at) || touched_shape;
+        for (std::size_t f = group.first; f < group.last; ++f)
+        {
+          const ShapeFeature& now = features_now_[k][f];
+          double gap2;
+          if (!ball->meetsSegment(now, start_features_[k][f], thickness, gap2))
+            continue;
+          if (gap2 < least)
+          {
+            least = gap2;
+            nearest = &now;
+          }
+          const TouchedFeature feature{ index, k, f };
+          if (touchFeature(model, start, state, h, feature))
+          {
+            touched_features_.push_back(feature);
+            touched_shape = true;
+          }
+        }
       }
-      if (!touched_shape)
-        side = sideOf(features_now_[k], corners());
-      touched = touched || touched_shape;
+      // The side a shape is on is remembered from a sub-step where it came near without touching; with
+      // none near, it is not known (faceTouch then takes it from the sub-step's start).
+      if (!nearest)
+        side = 0;
+      else if (!touched_shape)
+        side = sideOf(*nearest, corners());
+      if (touched_shape)
+      {
+        touched = true;
+        ball.reset();  // the triangle moved
+      }
     }
     return touched;
   }
 
-  /// Whether shape k's bounding ball, widened by `thickness`, comes within the triangle's bounding ball
-  /// anywhere on their straight paths from the sub-step's start to its end (relative to each other).
-  bool withinReach(std::size_t k, const TriangleCorners& now, const TriangleCorners& then, double thickness) const
+  /// Feature f of shape k against contact triangle `triangle` (faceTouch, on the side sides_ knows): true
+  /// if it touched, and the triangle was pushed.
+  bool touchFeature(const Model& model, const NodeArray& start, State& state, double h, const TouchedFeature& touched)
   {
-    const Vec3 centre = (now[0] + now[1] + now[2]) / 3.0, centre_then = (then[0] + then[1] + then[2]) / 3.0;
-    double size = 0.0;
-    for (int c = 0; c < 3; ++c)
-      size = std::max({ size, (now[c] - centre).norm(), (then[c] - centre_then).norm() });
-    const Vec3 offset = centre - shapes_[k].at.position, offset_then = centre_then - start_positions_[k];
-    const Vec3 path = offset - offset_then;
-    const double length2 = path.squaredNorm();
-    const double s = length2 > 0.0 ? std::clamp(-offset_then.dot(path) / length2, 0.0, 1.0) : 0.0;
-    const double reach = bounds_[k] + size + thickness;
-    return (offset_then + s * path).squaredNorm() <= reach * reach;
-  }
-
-  /// Whether feature f (f_start at the sub-step's start) comes within its radius plus `thickness` of the
-  /// triangle's bounding ball on their straight paths through the sub-step, its point nearest to the
-  /// triangle's centre followed: a table's far edges are skipped without a closer look.
-  static bool nearFeature(const ShapeFeature& f, const ShapeFeature& f_start, const TriangleCorners& now,
-                          const TriangleCorners& then, double thickness)
-  {
-    const Vec3 centre = (now[0] + now[1] + now[2]) / 3.0, centre_then = (then[0] + then[1] + then[2]) / 3.0;
-    double size = 0.0;
-    for (int c = 0; c < 3; ++c)
-      size = std::max({ size, (now[c] - centre).norm(), (then[c] - centre_then).norm() });
-    const Vec3 d = f.b - f.a;
-    const double length2 = d.squaredNorm();
-    const double s = length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0;
-    const Vec3 offset = centre - (f.a + s * d), offset_then = centre_then - (f_start.a + s * (f_start.b - f_start.a));
-    const Vec3 path = offset - offset_then;
-    const double path2 = path.squaredNorm();
-    const double t = path2 > 0.0 ? std::clamp(-offset_then.dot(path) / path2, 0.0, 1.0) : 0.0;
-    const double reach = size + f.radius + thickness;
-    return (offset_then + t * path).squaredNorm() <= reach * reach;
+    const std::array<int, 3>& triangle = model.contact_triangles[touched.triangle];
+    const double thickness = (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] +
+                              model.contact_radius[triangle[2]]) / 3.0;
+    const std::optional<FaceTouch> touch = faceTouch(
+        features_now_[touched.shape][touched.feature], start_features_[touched.shape][touched.feature],
+        TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]), state.position.col(triangle[2]) },
+        TriangleCorners{ start.col(triangle[0]), start.col(triangle[1]), start.col(triangle[2]) }, thickness,
+        kFaceSag * thickness, sides_[touched.triangle * shapes_.size() + touched.shape]);
+    return touch && pushTriangle(model, start, state, h, triangle, *touch, shapes_[touched.shape].at);
   }
 
   /// The triangle's point of `touch` leaves the shape as a node would, the correction shared by its nodes.
@@ -425,25 +446,74 @@ private:
     return true;
   }
 
-  /// The side of triangle t (+1: along its normal (t1 - t0) x (t2 - t0), -1: against it) where the
-  /// feature nearest to its centre lies.
-  static std::int8_t sideOf(const std::vector<ShapeFeature>& features, const TriangleCorners& t)
+  /// The side of triangle t (+1: along its normal (t1 - t0) x (t2 - t0), -1: against it) where feature
+  /// f's point nearest to its centre lies.
+  static std::int8_t sideOf(const ShapeFeature& f, const TriangleCorners& t)
   {
     const Vec3 centre = (t[0] + t[1] + t[2]) / 3.0;
-    double least = 1e300;
-    Vec3 nearest = centre;
-    for (const ShapeFeature& f : features)
+    const Vec3 d = f.b - f.a;
+    const double length2 = d.squaredNorm();
+    const Vec3 p = f.a + (length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0) * d;
+    return (t[1] - t[0]).cross(t[2] - t[0]).dot(p - centre) >= 0.0 ? 1 : -1;
+  }
+
+  /// Each contact triangle's axis-aligned bounding box over the sub-step (its corners at its start and
+  /// now, widened by its thickness: pushes within the sweep move it by about that), and each shape's
+  /// (its features at the start and now, widened by their radii and the thickest node's contact radius):
+  /// where the two boxes are apart, the triangle is not looked at more closely (a rail along a cloth's
+  /// width has a bounding ball as big as the cloth, but a box as thin as the rail).
+  void boxTriangles(const Model& model, const NodeArray& start, const NodeArray& x)
+  {
+    triangle_boxes_.resize(model.contact_triangles.size());
+    for (std::size_t t = 0; t < model.contact_triangles.size(); ++t)
     {
-      const Vec3 d = f.b - f.a;
-      const double length2 = d.squaredNorm();
-      const Vec3 p = f.a + (length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0) * d;
-      if ((p - centre).squaredNorm() < least)
+      const std::array<int, 3>& triangle = model.contact_triangles[t];
+      Eigen::AlignedBox3d& box = triangle_boxes_[t];
+      box.setEmpty();
+      double thickness = 0.0;
+      for (const int node : triangle)
       {
-        least = (p - centre).squaredNorm();
-        nearest = p;
+        box.extend(Vec3(x.col(node)));
+        box.extend(Vec3(start.col(node)));
+        thickness = std::max(thickness, model.contact_radius[node]);
+      }
+      box.min().array() -= thickness;
+      box.max().array() += thickness;
+    }
+    const double widest = model.contact_radius.maxCoeff();
+    shape_boxes_.resize(shapes_.size());
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      Eigen::AlignedBox3d& box = shape_boxes_[k];
+      box.setEmpty();
+      for (std::size_t f = 0; f < features_[k].size(); ++f)
+      {
+        const double reach = features_[k][f].radius + widest;
+        for (const ShapeFeature* feature : { &features_now_[k][f], &start_features_[k][f] })
+          for (const Vec3& end : { feature->a, feature->b })
+          {
+            box.extend(Vec3(end.array() - reach));
+            box.extend(Vec3(end.array() + reach));
+          }
       }
     }
-    return (t[1] - t[0]).cross(t[2] - t[0]).dot(nearest - centre) >= 0.0 ? 1 : -1;
+  }
+
+  /// Every shape's feature groups' centres in the scene frame now and at the sub-step's start.
+  void placeGroups(std::vector<std::vector<Vec3>>& now, std::vector<std::vector<Vec3>>& then) const
+  {
+    now.resize(shapes_.size());
+    then.resize(shapes_.size());
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      now[k].clear();
+      then[k].clear();
+      for (const FeatureGroup& group : groups_[k])
+      {
+        now[k].push_back(shapes_[k].at.position + shapes_[k].at.orientation * group.centre);
+        then[k].push_back(start_positions_[k] + start_orientations_[k] * group.centre);
+      }
+    }
   }
 
   /// Every shape's features in the scene frame, where the shapes are now (face_contacts.h), into `placed`.
@@ -498,8 +568,12 @@ private:
   /// per contact triangle and shape: the side of the triangle the shape was on when they last came near
   /// without touching (sideOf; 0: not near then)
   std::vector<std::int8_t> sides_;
-  std::vector<std::size_t> touched_triangles_;  ///< contact triangles touched in this sub-step's first sweep
-  std::vector<Vec3> start_positions_;  ///< per shape: its origin at the start of the current sub-step [m]
+  std::vector<TouchedFeature> touched_features_;  ///< those of this sub-step's first sweep
+  std::vector<std::vector<FeatureGroup>> groups_;  ///< per shape: its features in groups, for the search
+  std::vector<std::vector<Vec3>> group_centres_now_, group_centres_then_;  ///< placeGroups
+  std::vector<Eigen::AlignedBox3d> triangle_boxes_, shape_boxes_;           ///< boxTriangles
+  std::vector<Vec3> start_positions_;
+  std::vector<Eigen::Quaterniond> start_orientations_;  ///< per shape: its orientation at the sub-step's start  ///< per shape: its origin at the start of the current sub-step [m]
 };
 
 }  // namespace soft_body_sim
