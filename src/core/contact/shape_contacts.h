@@ -86,7 +86,10 @@ class ShapeContacts final : public ColliderKind
 {
 public:
   ShapeContacts(std::vector<Shape> shapes, int nodes)
-    : shapes_(std::move(shapes)), goals_(shapes_.size()), touching_(static_cast<std::size_t>(nodes), 0)
+    : shapes_(std::move(shapes))
+    , goals_(shapes_.size())
+    , touching_(static_cast<std::size_t>(nodes), 0)
+    , received_(shapes_.size())
   {
     for (Shape& shape : shapes_)
     {
@@ -129,9 +132,11 @@ public:
         const Vec3 normal = at.orientation * surface.normal;
         const Vec3 contact = at.position + at.orientation * surface.closest;
         const Vec3 velocity = at.velocity + at.angular_velocity.cross(contact - at.position);
-        const double approach = -(Vec3(state.velocity.col(i)) - velocity).dot(normal);
+        const Vec3 v0 = state.velocity.col(i);
+        const double approach = -(v0 - velocity).dot(normal);
         leaveSurface({ normal, velocity, at.friction, at.restitution }, depth, !was_touching && approach > resting_speed,
                      h, state.position.col(i) - start.col(i), state.position.col(i), state.velocity.col(i));
+        push(k, contact, model.mass[i] * (v0 - state.velocity.col(i)));
       }
       touching_[static_cast<std::size_t>(i)] = touched ? 1 : 0;
       touched_any = touched_any || touched;
@@ -160,10 +165,23 @@ public:
         continue;
       const Vec3 point = at.orientation * surface.closest;
       contact = NodeContact{ at.orientation * surface.normal, at.velocity + at.angular_velocity.cross(point),
-                             at.friction, depth };
+                             at.friction, depth, static_cast<int>(k) };
       found = true;
     }
     return found;
+  }
+
+  std::size_t count() const override { return shapes_.size(); }
+
+  void receive(std::size_t shape, const Vec3& point, const Vec3& impulse) override { push(shape, point, impulse); }
+
+  void clearImpulses() override { std::fill(received_.begin(), received_.end(), ReceivedImpulse{}); }
+
+  void appendWrenches(double dt, std::vector<ColliderWrench>& wrenches) const override
+  {
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+      if (!shapes_[k].at.name.empty())
+        wrenches.push_back({ shapes_[k].at.name, received_[k].over(dt) });
   }
 
   void appendPoses(std::vector<ColliderPose>& poses) const override
@@ -274,6 +292,7 @@ private:
       state.position.col(b) += kb * (x - x0);
       state.velocity.col(a) += ka * (v - v0);
       state.velocity.col(b) += kb * (v - v0);
+      push(k, contact, -(ka * model.mass[a] + kb * model.mass[b]) * (v - v0));
     }
     return touched;
   }
@@ -289,6 +308,15 @@ private:
   {
     const double radius = model.contact_radius[node];
     return depth < radius && surfaceDistance(shape, local).distance < 1.25 * radius + 1e-6;
+  }
+
+  /// Shape `shape` received `impulse` [N s] at `point` [m]: the opposite of the momentum a contact gave
+  /// the nodes (their mass times their velocity change; a position correction alone carries none, and a
+  /// node resting on the shape loses the g h it gained in the sub-step, so that the impulses of a step sum
+  /// to its weight times dt).
+  void push(std::size_t shape, const Vec3& point, const Vec3& impulse)
+  {
+    received_[shape].add(point - shapes_[shape].at.position, impulse);
   }
 
   /// Every shape moves by its constant velocity and turns by its angular velocity over h.
@@ -310,6 +338,7 @@ private:
   std::vector<char> placed_;                     ///< per shape: has a pose in the scene (collides, is drawn)
   std::vector<double> bounds_;                   ///< per shape: boundingRadius [m]
   std::vector<std::uint8_t> touching_;  ///< per node: on one of these shapes after the last sub-step
+  std::vector<ReceivedImpulse> received_;  ///< per shape: from the bodies since the step began
 };
 
 }  // namespace soft_body_sim
