@@ -152,7 +152,7 @@ TEST(Simulate, ForcesAndTensionsGoToTheirFilesAtTheRowsTimes)
 {
   // A 0.5 kg mass hanging at rest from an anchored 0.1 kg node on a spring of 49.05 N/m, stretched
   // 0.1 m by the mass's weight: the spring's tension is 0.5 g, the anchor carries both weights; a 0.2 kg
-  // ball rests on the named floor.
+  // ball rests on the named floor below them.
   const std::string scene = writeScene("hanging.yaml", R"(
 frame_id: world
 physics: {integrator: semi_implicit_euler, dt: 0.01, gravity: [0, 0, -9.81]}
@@ -169,9 +169,9 @@ bodies:
   - name: ball
     type: custom
     nodes:
-      - {position: [1, 0, 0.0], mass: 0.2}
+      - {position: [1, 0, -2], mass: 0.2}
 planes:
-  - {name: floor, point: [0, 0, 0], normal: [0, 0, 1]}
+  - {name: floor, point: [0, 0, -2], normal: [0, 0, 1]}
 )");
   const std::string forces = ::testing::TempDir() + "forces.csv";
   const std::string tensions = ::testing::TempDir() + "tensions.csv";
