@@ -238,7 +238,7 @@ class ClothOnARail : public ::testing::TestWithParam<FingerCase>
 // more than a tenth of the thickness (it sinks into the cloth's thickness by at most kFaceSag of it), and
 // after 6 s the cloth rests on the rail: its highest node at the rail's top plus the thickness (the two
 // rows beside the rail lie on it, the square between them over it), hanging evenly on both sides (its
-// mean y at the rail's, to 2 mm), nearly still.
+// mean y at the rail's, to 2 mm), nearly still, its weight on the rail.
 TEST_P(ClothOnARail, AClothDroppedOnARailThinnerThanItsSpacingRestsDrapedOnIt)
 {
   const double radius = 0.005, thickness = 0.005, height = 0.9;
@@ -261,6 +261,18 @@ TEST_P(ClothOnARail, AClothDroppedOnARailThinnerThanItsSpacingRestsDrapedOnIt)
   EXPECT_NEAR(x.row(2).maxCoeff(), height + radius + thickness, kFaceSag * thickness);
   EXPECT_NEAR(x.row(1).mean(), 0.0, 0.002);
   EXPECT_LT(world.state().velocity.colwise().norm().maxCoeff(), 0.05);
+  // The rail carries the whole cloth, much of it on the faces between the two rows beside it: its wrench
+  // (what the cloth exerts on it) is the cloth's weight, down, within 2 %.
+  const double weight = 0.3 * 9.81;
+  bool found = false;
+  for (const ColliderWrench& w : world.colliderWrenches())
+    if (w.name == "rail")
+    {
+      found = true;
+      EXPECT_NEAR(w.wrench.force.z(), -weight, 0.02 * weight);
+      EXPECT_NEAR(w.wrench.force.head<2>().norm(), 0.0, 0.02 * weight);
+    }
+  EXPECT_TRUE(found);
   RecordProperty("max_speed_at_6s", std::to_string(world.state().velocity.colwise().norm().maxCoeff()));
 }
 

@@ -1110,9 +1110,26 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
                    { "unknown key", "param, friction, restitution" });
   expectSceneError("colliders: [{name: a, shape: sphere, radius: 1}, {name: a, shape: sphere, radius: 2}]\n" + body,
                    "bad.yaml:1: colliders[1].name", { "duplicate collider name 'a'" });
+  // A plane's name is a collider name too (each names a wrench).
+  expectSceneError("planes: [{name: a, point: [0, 0, 0], normal: [0, 0, 1]}]\n"
+                   "colliders: [{name: a, shape: sphere, radius: 1}]\n" + body,
+                   "bad.yaml:2: colliders[0].name", { "duplicate collider name 'a'", "planes[0]" });
+  expectSceneError("planes: [{name: '', point: [0, 0, 0], normal: [0, 0, 1]}]\n" + body, "bad.yaml:1: planes[0].name",
+                   {});
   expectSceneError("bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1, "
                    "radius: -0.1}]\n",
                    "bad.yaml:1: bodies[0].radius", { "radius must be >= 0", "-0.1" });
+}
+
+TEST(SceneLoader, APlaneTakesAnOptionalName)
+{
+  const SceneDef scene = parseScene("planes: [{name: floor, point: [0, 0, 0], normal: [0, 0, 1]}, "
+                                    "{point: [1, 0, 0], normal: [-1, 0, 0]}]\n"
+                                    "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n",
+                                    "planes.yaml");
+  ASSERT_EQ(scene.colliders.planes.size(), 2u);
+  EXPECT_EQ(scene.colliders.planes[0].name, "floor");
+  EXPECT_EQ(scene.colliders.planes[1].name, "");
 }
 
 TEST(SceneLoader, RopeSelfCollisionAndFrictionAreReadAndNeedARadius)

@@ -151,7 +151,8 @@ TEST(Simulate, CommandLineOverridesTheSceneAndCsvGoesToTheFile)
 TEST(Simulate, ForcesAndTensionsGoToTheirFilesAtTheRowsTimes)
 {
   // A 0.5 kg mass hanging at rest from an anchored 0.1 kg node on a spring of 49.05 N/m, stretched
-  // 0.1 m by the mass's weight: the spring's tension is 0.5 g, the anchor carries both weights.
+  // 0.1 m by the mass's weight: the spring's tension is 0.5 g, the anchor carries both weights; a 0.2 kg
+  // ball rests on the named floor below them.
   const std::string scene = writeScene("hanging.yaml", R"(
 frame_id: world
 physics: {integrator: semi_implicit_euler, dt: 0.01, gravity: [0, 0, -9.81]}
@@ -165,6 +166,12 @@ bodies:
       - {nodes: [0, 1], stiffness: 49.05, rest_length: 1.0}
     anchors:
       - {name: hook, node: 0}
+  - name: ball
+    type: custom
+    nodes:
+      - {position: [1, 0, -2], mass: 0.2}
+planes:
+  - {name: floor, point: [0, 0, -2], normal: [0, 0, 1]}
 )");
   const std::string forces = ::testing::TempDir() + "forces.csv";
   const std::string tensions = ::testing::TempDir() + "tensions.csv";
@@ -176,14 +183,22 @@ bodies:
     return rows(std::string((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>()));
   };
   const auto force_rows = read(forces);
-  ASSERT_EQ(force_rows.size(), 4u);  // header, t = 0, 0.05, 0.1
+  ASSERT_EQ(force_rows.size(), 7u);  // header, then the hook and the floor at t = 0, 0.05, 0.1
   EXPECT_EQ(force_rows[0], (std::vector<std::string>{ "t", "body", "anchor", "fx", "fy", "fz", "tx", "ty", "tz" }));
-  EXPECT_EQ(force_rows[2][0], "0.050000000000000003");
-  EXPECT_EQ(force_rows[3][1], "weight");
-  EXPECT_EQ(force_rows[3][2], "hook");
-  EXPECT_NEAR(std::stod(force_rows[3][5]), -0.6 * 9.81, 1e-9);
+  EXPECT_EQ(force_rows[3][0], "0.050000000000000003");
+  EXPECT_EQ(force_rows[5][1], "weight");
+  EXPECT_EQ(force_rows[5][2], "hook");
+  EXPECT_NEAR(std::stod(force_rows[5][5]), -0.6 * 9.81, 1e-9);
   for (int column : { 3, 4, 6, 7, 8 })
-    EXPECT_NEAR(std::stod(force_rows[3][column]), 0.0, 1e-12) << column;
+    EXPECT_NEAR(std::stod(force_rows[5][column]), 0.0, 1e-12) << column;
+  // The ball resting on the floor, 1 m from its point: its weight, and about the point the torque
+  // (1, 0, 0) x (0, 0, -m g) = (0, m g, 0).
+  EXPECT_EQ(force_rows[6][1], "");
+  EXPECT_EQ(force_rows[6][2], "floor");
+  EXPECT_NEAR(std::stod(force_rows[6][5]), -0.2 * 9.81, 1e-9);
+  EXPECT_NEAR(std::stod(force_rows[6][7]), 0.2 * 9.81, 1e-9);
+  for (int column : { 3, 4, 6, 8 })
+    EXPECT_NEAR(std::stod(force_rows[6][column]), 0.0, 1e-12) << column;
   const auto tension_rows = read(tensions);
   ASSERT_EQ(tension_rows.size(), 4u);
   EXPECT_EQ(tension_rows[0], (std::vector<std::string>{ "t", "body", "kind", "index", "a", "b", "tension" }));

@@ -53,6 +53,7 @@ void World::step()
   anchors_.goalsFromPaths(time() + dt);
   grasps_.goalsFromPaths(time() + dt);
   contacts_.goalsFromPaths(time() + dt, dt);
+  contacts_.beginStep(dt);
   const bool kinematic = driveKinematicNodes(dt);
   for (int substep = 0; substep < settings_.substeps; ++substep)
   {

@@ -22,6 +22,9 @@ void addRobotColliders(const std::string& urdf_xml, const RobotCollidersDef& rob
   std::set<std::string> names;
   for (const ColliderPlacement* at : placements(colliders))
     names.insert(at->name);
+  for (const Plane& plane : colliders.planes)
+    if (!plane.name.empty())
+      names.insert(plane.name);
   int added = 0;
   for (const auto& [link_name, link] : model.links_)
   {

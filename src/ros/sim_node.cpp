@@ -249,6 +249,7 @@ void SimNode::publish()
   state_publisher_.publish(RosConverter::toState(*world_, scene_.frame_id, stamp, statistics_, holders, slips_));
   slips_.clear();
   publishWrenches(holders, stamp);
+  publishColliderWrenches(stamp);
   for (std::size_t k = 0; k < handle_names_.size(); ++k)
     if (!handle_names_[k].empty())
       handles_->follow(handle_names_[k], state.position.col(world_->model().anchors[k].node));
@@ -281,6 +282,30 @@ void SimNode::publishWrenches(const std::vector<Holder>& holders, const ros::Tim
     publishers.emplace(topic, publisher);
   }
   wrench_publishers_.swap(publishers);  // the topics of holders gone are no longer advertised
+}
+
+void SimNode::publishColliderWrenches(const ros::Time& stamp)
+{
+  for (const ColliderWrench& collider : world_->colliderWrenches())
+  {
+    auto found = collider_wrench_publishers_.find(collider.name);
+    if (found == collider_wrench_publishers_.end())
+    {
+      const std::string topic = "colliders/" + collider.name + "/wrench";
+      std::string why;
+      if (!ros::names::validate(topic, why))
+      {
+        // A URDF link may be named what a topic may not ("link-1").
+        ROS_WARN_THROTTLE(60.0, "%s: no wrench topic for collider '%s': %s (its wrench is in ~state)",
+                          name_.c_str(), collider.name.c_str(), why.c_str());
+        continue;
+      }
+      found = collider_wrench_publishers_
+                  .emplace(collider.name, private_nh_.advertise<geometry_msgs::WrenchStamped>(topic, 10))
+                  .first;
+    }
+    found->second.publish(RosConverter::toWrench(collider.wrench, scene_.frame_id, stamp));
+  }
 }
 
 bool SimNode::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&)

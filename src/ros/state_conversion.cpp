@@ -45,6 +45,14 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
   state.real_time_factor = statistics.real_time_factor;
   state.wall_seconds_per_step = statistics.wall_seconds_per_step;
   state.divergence_events = statistics.divergence_events;
+  for (const ColliderWrench& collider : world.colliderWrenches())
+  {
+    state.colliders.push_back(collider.name);
+    geometry_msgs::Wrench wrench;
+    wrench.force = toVector3(collider.wrench.force);
+    wrench.torque = toVector3(collider.wrench.torque);
+    state.collider_wrenches.push_back(wrench);
+  }
   for (std::size_t b = 0; b < world.model().bodies.size(); ++b)
   {
     const BodyRange& range = world.model().bodies[b];

@@ -23,7 +23,7 @@ using namespace scene_yaml;
 const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "colliders", "robot_colliders", "bodies" };
 const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag", "guard" };
 const Keys kGuardKeys = { "policy", "max_speed" };
-const Keys kPlaneKeys = { "point", "normal", "restitution", "friction" };
+const Keys kPlaneKeys = { "name", "point", "normal", "restitution", "friction" };
 const Keys kAnchorKeys = { "name", "node", "frame" };
 const Keys kPlacementKeys = { "name",     "shape",    "position",         "orientation", "velocity",
                               "friction", "angular_velocity", "restitution", "frame" };
@@ -107,6 +107,7 @@ Plane readPlane(const Context& ctx, const Field& field)
     ctx.fail(normal, "must not be the zero vector");
   readOptional(ctx, field, "restitution", plane.restitution, readFraction);
   readOptional(ctx, field, "friction", plane.friction, readNonNegative);
+  readOptional(ctx, field, "name", plane.name, readNonEmptyString);
   return plane;
 }
 
@@ -291,22 +292,27 @@ SceneDef readScene(const Context& ctx, const Field& root, const SceneLimits& lim
   readOptional(ctx, root, "frame_id", scene.frame_id, readNonEmptyString);
   readOptional(ctx, root, "rate", scene.rate, readPositive);
   readOptional(ctx, root, "physics", scene.physics, readPhysics);
+  // Planes and colliders share their names (each names a wrench: World::colliderWrenches).
+  std::map<std::string, std::string> collider_by_name;  // to name the first collider in a duplicate error
+  const auto unique = [&](const Field& item, const std::string& name) {
+    const auto [first, inserted] = collider_by_name.emplace(name, item.path);
+    if (!inserted)
+      ctx.fail(requiredKey(ctx, item, "name"), "duplicate collider name " + quoted(name) + " (first used by " +
+                                                   first->second + ")");
+  };
   if (const std::optional<Field> planes = optionalKey(root, "planes"))
     for (const Field& item : requireList(ctx, *planes))
+    {
       scene.colliders.planes.push_back(readPlane(ctx, item));
+      if (!scene.colliders.planes.back().name.empty())
+        unique(item, scene.colliders.planes.back().name);
+    }
   if (const std::optional<Field> colliders = optionalKey(root, "colliders"))
-  {
-    std::map<std::string, std::string> path_by_name;  // to name the first collider in a duplicate error
     for (const Field& item : requireList(ctx, *colliders))
     {
       readCollider(ctx, item, scene.colliders);
-      const std::string name = readNonEmptyString(ctx, requiredKey(ctx, item, "name"));
-      const auto [first, inserted] = path_by_name.emplace(name, item.path);
-      if (!inserted)
-        ctx.fail(requiredKey(ctx, item, "name"), "duplicate collider name " + quoted(name) + " (first used by " +
-                                                     first->second + ")");
+      unique(item, readNonEmptyString(ctx, requiredKey(ctx, item, "name")));
     }
-  }
 
   readOptional(ctx, root, "robot_colliders", scene.robot_colliders, readRobotColliders);
 

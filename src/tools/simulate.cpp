@@ -37,7 +37,7 @@ struct Options
   std::optional<int> iterations;
   std::optional<long long> every;
   std::optional<std::string> csv;
-  std::optional<std::string> forces;    ///< anchors' wrenches
+  std::optional<std::string> forces;    ///< anchors' and colliders' wrenches
   std::optional<std::string> tensions;  ///< links' tensions
 };
 
@@ -165,7 +165,9 @@ void writeRows(std::ostream& csv, const World& world)
   }
 }
 
-/// Per anchor, the wrench its body exerts on it (World::anchorWrenches).
+/// Per anchor, the wrench its body exerts on it (World::anchorWrenches); then per named collider, with an
+/// empty body (no body is unnamed), the wrench the bodies exerted on it over the last step
+/// (World::colliderWrenches).
 void writeForces(std::ostream& csv, const World& world)
 {
   const std::vector<Wrench> wrenches = world.anchorWrenches();
@@ -176,6 +178,13 @@ void writeForces(std::ostream& csv, const World& world)
     const Vec3& m = wrenches[k].torque;
     csv << world.time() << ',' << anchor.body << ',' << anchor.name << ',' << f.x() << ',' << f.y() << ',' << f.z()
         << ',' << m.x() << ',' << m.y() << ',' << m.z() << '\n';
+  }
+  for (const ColliderWrench& collider : world.colliderWrenches())
+  {
+    const Vec3& f = collider.wrench.force;
+    const Vec3& m = collider.wrench.torque;
+    csv << world.time() << ",," << collider.name << ',' << f.x() << ',' << f.y() << ',' << f.z() << ',' << m.x()
+        << ',' << m.y() << ',' << m.z() << '\n';
   }
 }
 

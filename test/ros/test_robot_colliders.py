@@ -1,11 +1,13 @@
 #!/usr/bin/python3
 """Colliders from a URDF (launched by robot_colliders.test): the table, post, knob and bracket (a mesh) of
 test_robot.urdf follow their links as robot_state_publisher moves them; a rope dropped onto the table
-rests on its top; the table's and the bracket's markers follow the prismatic joint."""
+rests on its top, pressing the table's collider (named by its link) with its weight; the table's and the
+bracket's markers follow the prismatic joint."""
 import threading
 
 import rospy
 import rostest
+from geometry_msgs.msg import WrenchStamped
 from sensor_msgs.msg import JointState
 from std_srvs.srv import Empty
 from visualization_msgs.msg import MarkerArray
@@ -15,6 +17,7 @@ from node_client import NodeTestCase, StateWatcher, wait_for
 NODE = "/soft_body_sim"
 TABLE_TOP = 0.25     # [m] the box's top: its origin 0.2 m above the link, half its 0.1 m height
 ROPE_RADIUS = 0.005  # [m]
+ROPE_WEIGHT = 0.04 * 9.81  # [N]
 
 
 class RobotCollidersTest(NodeTestCase):
@@ -59,6 +62,17 @@ class RobotCollidersTest(NodeTestCase):
         self.assertGreater(min(z), TABLE_TOP + ROPE_RADIUS - 1e-3, z)
         self.assertLess(abs(z[10] - (TABLE_TOP + ROPE_RADIUS)), 2e-3, z)
         self.assertLess(abs(self.shapes()[1].pose.position.x), 1e-3)  # 1 = CUBE: the table at slide 0
+        # The rope at rest presses the table down with its weight (the mean over 20 ticks).
+        wrenches = []
+        subscriber = rospy.Subscriber(NODE + "/colliders/table/wrench", WrenchStamped, wrenches.append,
+                                      queue_size=100)
+        try:
+            self.assertTrue(wait_for(lambda: len(wrenches) > 20, 10.0), "no wrench on ~colliders/table/wrench")
+        finally:
+            subscriber.unregister()
+        self.assertEqual(wrenches[-1].header.frame_id, "world")
+        mean_z = sum(w.wrench.force.z for w in wrenches[-20:]) / 20
+        self.assertAlmostEqual(mean_z, -ROPE_WEIGHT, delta=0.02 * ROPE_WEIGHT)
         # The joint moves the table 0.1 m along x; its marker and the post on it follow.
         with self.lock:
             type(self).slide = 0.1  # the class's: the timer publishes it

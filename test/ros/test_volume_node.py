@@ -1,9 +1,9 @@
 #!/usr/bin/python3
 """A soft solid the ROS way (launched by volume.test on config/scenes/soft_box.yaml): the markers draw
 the box as its surface (a TRIANGLE_LIST, every point finite) and its nodes in a namespace of their own;
-it lands and rests on the table; a gripper closing on its top and rising lifts it off the table, and the
-gripper's wrench topic carries the box's weight, rho a^3 g (its lumped masses sum to rho times its
-volume)."""
+it lands and rests on the table, whose wrench topic (and ~state) carries the box's weight, rho a^3 g (its
+lumped masses sum to rho times its volume); a gripper closing on its top and rising lifts it off the
+table, and the gripper's wrench topic carries that weight."""
 import math
 
 import rospy
@@ -46,6 +46,7 @@ class VolumeNodeTest(NodeTestCase):
     def test_a_grasp_on_its_top_lifts_it_and_reads_its_weight(self):
         self.settle()
         self.assertAlmostEqual(min(p[2] for p in self.box()), TABLE_TOP, delta=1e-3)
+        self.the_table_carries_the_box()
         top = max(p[2] for p in self.box())
         start = rospy.Time.now().to_sec() + 1.0
 
@@ -73,6 +74,28 @@ class VolumeNodeTest(NodeTestCase):
         finally:
             subscriber.unregister()
         self.assertTrue(self.release(frame="hand").success)
+
+    def the_table_carries_the_box(self):
+        """The box at rest presses on the table with its weight, in the scene frame (~colliders/table/wrench,
+        the mean over 20 ticks: a tick's wrench is its last step's), the pad above it feels nothing, and
+        ~state lists both with the same wrenches."""
+        tables, pads = [], []
+        subscribers = [rospy.Subscriber(NODE + "/colliders/" + name + "/wrench", WrenchStamped, into.append,
+                                        queue_size=100) for name, into in (("table", tables), ("pad", pads))]
+        try:
+            self.assertTrue(wait_for(lambda: len(tables) > 20 and len(pads) > 0, 10.0),
+                            "no wrench on ~colliders/table/wrench or ~colliders/pad/wrench")
+        finally:
+            for subscriber in subscribers:
+                subscriber.unregister()
+        self.assertEqual(tables[-1].header.frame_id, "world")
+        forces = [w.wrench.force for w in tables[-20:]]
+        self.assertAlmostEqual(sum(f.z for f in forces) / len(forces), -WEIGHT, delta=0.02 * WEIGHT)
+        self.assertLess(max(math.hypot(f.x, f.y) for f in forces), 0.02 * WEIGHT)
+        self.assertEqual(pads[-1].wrench.force.z, 0.0)
+        state = self.state.next(1)
+        self.assertEqual(list(state.colliders), ["table", "pad"])
+        self.assertAlmostEqual(state.collider_wrenches[0].force.z, -WEIGHT, delta=0.05 * WEIGHT)
 
     def test_the_markers_draw_its_surface_and_its_nodes_apart(self):
         count = len(self.markers)

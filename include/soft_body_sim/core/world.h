@@ -162,6 +162,13 @@ public:
   /// Per grasp of grasps(), the wrench its body exerts on it, torque about its frame's origin (on a rod,
   /// with the rod's moments at the stations the grasp holds, stationTorque).
   std::vector<Wrench> graspWrenches() const;
+  /// Per named collider of the scene (planes, spheres, capsules, boxes, cylinders, meshes, each in
+  /// declaration order; the robot's colliders among them), the wrench the bodies exerted on it in the last
+  /// step: every contact impulse it received in the step's sub-steps (the contact stage's and those the
+  /// integrators' solves took into themselves), summed and divided by dt, the torque about its origin (a
+  /// plane's `point`), both in the scene frame. A body resting on it presses with its weight. Zero before
+  /// the first step; empty without named colliders.
+  std::vector<ColliderWrench> colliderWrenches() const { return contacts_.wrenches(); }
 
   /// Kinetic + potential energy [J] (see forces.h).
   double energy() const;

@@ -64,7 +64,7 @@ public:
 
   /// The state: per body its name, positions [m], velocities [m/s], integrator, what the divergence guard
   /// did to it, its holders (`holders`, see holders()) and their wrenches, its links' tensions and the
-  /// `slips` of its grasps; and the step statistics.
+  /// `slips` of its grasps; the step statistics; and the named colliders' wrenches (World::colliderWrenches).
   static SimState toState(const World& world, const std::string& frame_id, const ros::Time& stamp,
                           const StepStatistics& statistics, const std::vector<Holder>& holders = {},
                           const std::vector<GraspSlip>& slips = {});

@@ -106,6 +106,8 @@ private:
   /// Publishes each holder's wrench on ~<body>/<name>/wrench, advertising new holders' topics and
   /// dropping those of holders gone.
   void publishWrenches(const std::vector<Holder>& holders, const ros::Time& stamp);
+  /// Publishes each named collider's wrench (World::colliderWrenches) on ~colliders/<name>/wrench.
+  void publishColliderWrenches(const ros::Time& stamp);
 
   // --- tuning and health (sim_node_tuning.cpp)
   void startReconfigure();
@@ -156,6 +158,7 @@ private:
   ros::ServiceServer grasp_service_;
   ros::ServiceServer release_service_;
   std::map<std::string, ros::Publisher> wrench_publishers_;  ///< by topic, per anchor and grasp
+  std::map<std::string, ros::Publisher> collider_wrench_publishers_;  ///< by collider name
   ros::Timer timer_;
   std::unique_ptr<AnchorHandles> handles_;
   std::unique_ptr<ReconfigureServer<SimConfig>> sim_reconfigure_;

@@ -109,7 +109,10 @@ class ShapeContacts final : public ColliderKind
 {
 public:
   ShapeContacts(std::vector<Shape> shapes, int nodes)
-    : shapes_(std::move(shapes)), goals_(shapes_.size()), touching_(static_cast<std::size_t>(nodes), 0)
+    : shapes_(std::move(shapes))
+    , goals_(shapes_.size())
+    , touching_(static_cast<std::size_t>(nodes), 0)
+    , received_(shapes_.size())
   {
     for (Shape& shape : shapes_)
     {
@@ -165,9 +168,11 @@ public:
         const Vec3 normal = at.orientation * surface.normal;
         const Vec3 contact = at.position + at.orientation * surface.closest;
         const Vec3 velocity = at.velocity + at.angular_velocity.cross(contact - at.position);
-        const double approach = -(Vec3(state.velocity.col(i)) - velocity).dot(normal);
+        const Vec3 v0 = state.velocity.col(i);
+        const double approach = -(v0 - velocity).dot(normal);
         leaveSurface({ normal, velocity, at.friction, at.restitution }, depth, !was_touching && approach > resting_speed,
                      h, state.position.col(i) - start.col(i), state.position.col(i), state.velocity.col(i));
+        push(k, contact, model.mass[i] * (v0 - state.velocity.col(i)));
       }
       touching_[static_cast<std::size_t>(i)] = touched ? 1 : 0;
       touched_any = touched_any || touched;
@@ -212,10 +217,23 @@ public:
         continue;
       const Vec3 point = at.orientation * surface.closest;
       contact = NodeContact{ at.orientation * surface.normal, at.velocity + at.angular_velocity.cross(point),
-                             at.friction, depth };
+                             at.friction, depth, static_cast<int>(k) };
       found = true;
     }
     return found;
+  }
+
+  std::size_t count() const override { return shapes_.size(); }
+
+  void receive(std::size_t shape, const Vec3& point, const Vec3& impulse) override { push(shape, point, impulse); }
+
+  void clearImpulses() override { std::fill(received_.begin(), received_.end(), ReceivedImpulse{}); }
+
+  void appendWrenches(double dt, std::vector<ColliderWrench>& wrenches) const override
+  {
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+      if (!shapes_[k].at.name.empty())
+        wrenches.push_back({ shapes_[k].at.name, received_[k].over(dt) });
   }
 
   void appendPoses(std::vector<ColliderPose>& poses) const override
@@ -326,6 +344,7 @@ private:
       state.position.col(b) += kb * (x - x0);
       state.velocity.col(a) += ka * (v - v0);
       state.velocity.col(b) += kb * (v - v0);
+      push(k, contact, -(ka * model.mass[a] + kb * model.mass[b]) * (v - v0));
     }
     return touched;
   }
@@ -412,13 +431,14 @@ private:
         TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]), state.position.col(triangle[2]) },
         TriangleCorners{ start.col(triangle[0]), start.col(triangle[1]), start.col(triangle[2]) }, thickness,
         kFaceSag * thickness, sides_[touched.triangle * shapes_.size() + touched.shape]);
-    return touch && pushTriangle(model, start, state, h, triangle, *touch, shapes_[touched.shape].at);
+    return touch && pushTriangle(model, start, state, h, triangle, *touch, touched.shape);
   }
 
   /// The triangle's point of `touch` leaves the shape as a node would, the correction shared by its nodes.
   bool pushTriangle(const Model& model, const NodeArray& start, State& state, double h,
-                    const std::array<int, 3>& triangle, const FaceTouch& touch, const ColliderPlacement& at)
+                    const std::array<int, 3>& triangle, const FaceTouch& touch, std::size_t k)
   {
+    const ColliderPlacement& at = shapes_[k].at;
     double s = 0.0;
     Vec3 x = Vec3::Zero(), v = Vec3::Zero(), x_start = Vec3::Zero();
     for (int c = 0; c < 3; ++c)
@@ -436,13 +456,16 @@ private:
     const Vec3 x0 = x, v0 = v;
     leaveSurface({ touch.normal, velocity, at.friction, at.restitution }, touch.depth,
                  approach > restingSpeed(model.gravity, h), h, x - x_start, x, v);
+    double moved_mass = 0.0;  // the momentum the nodes gain is moved_mass (v - v0)
     for (int c = 0; c < 3; ++c)
     {
       const int node = triangle[c];
       const double share = std::min(touch.weight[c] * model.inverse_mass[node] / s, kMaxLever);
       state.position.col(node) += share * (x - x0);
       state.velocity.col(node) += share * (v - v0);
+      moved_mass += share * model.mass[node];
     }
+    push(k, touch.contact, -moved_mass * (v - v0));
     return true;
   }
 
@@ -543,6 +566,15 @@ private:
     return depth < radius && surfaceDistance(shape, local).distance < 1.25 * radius + 1e-6;
   }
 
+  /// Shape `shape` received `impulse` [N s] at `point` [m]: the opposite of the momentum a contact gave
+  /// the nodes (their mass times their velocity change; a position correction alone carries none, and a
+  /// node resting on the shape loses the g h it gained in the sub-step, so that the impulses of a step sum
+  /// to its weight times dt).
+  void push(std::size_t shape, const Vec3& point, const Vec3& impulse)
+  {
+    received_[shape].add(point - shapes_[shape].at.position, impulse);
+  }
+
   /// Every shape moves by its constant velocity and turns by its angular velocity over h.
   void move(double h)
   {
@@ -572,8 +604,9 @@ private:
   std::vector<std::vector<FeatureGroup>> groups_;  ///< per shape: its features in groups, for the search
   std::vector<std::vector<Vec3>> group_centres_now_, group_centres_then_;  ///< placeGroups
   std::vector<Eigen::AlignedBox3d> triangle_boxes_, shape_boxes_;           ///< boxTriangles
-  std::vector<Vec3> start_positions_;
-  std::vector<Eigen::Quaterniond> start_orientations_;  ///< per shape: its orientation at the sub-step's start  ///< per shape: its origin at the start of the current sub-step [m]
+  std::vector<Vec3> start_positions_;  ///< per shape: its origin at the start of the current sub-step [m]
+  std::vector<Eigen::Quaterniond> start_orientations_;  ///< per shape: its orientation then
+  std::vector<ReceivedImpulse> received_;  ///< per shape: from the bodies since the step began
 };
 
 }  // namespace soft_body_sim

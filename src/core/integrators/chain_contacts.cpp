@@ -50,6 +50,9 @@ void ChainContacts::setPaths(const Model& model, std::vector<ChainPath> paths)
   contact_.assign(static_cast<std::size_t>(nodes), NodeContact{ Vec3::UnitZ(), Vec3::Zero(), 0.0, 0.0 });
   slip_.setZero(3, count);
   impulse_.setZero(3, count);
+  pressed_.clear();
+  pressed_.reserve(nodes_.size());  // no allocation in a sub-step
+  force_.setZero(3, count);
 }
 
 Vec3 ChainContacts::along(const ChainPath& path, std::size_t j, const NodeArray& x) const
@@ -230,6 +233,7 @@ bool ChainContacts::check(const Model& model, const std::vector<SweepRow>& rows,
     impulse_.col(rows[r].b) -= push;
   }
   bool changed = false;
+  pressed_.clear();
   forEachRun([&](const ChainPath& path, std::size_t first, std::size_t end) {
     const bool stuck = holds_.kind[static_cast<std::size_t>(path.nodes[first])] == NodeHolds::kStick;
     bool lifts = false, exceeds = false;
@@ -240,6 +244,8 @@ bool ChainContacts::check(const Model& model, const std::vector<SweepRow>& rows,
       const std::size_t k = static_cast<std::size_t>(i);
       const NodeContact& contact = contact_[k];
       const Vec3 force = ((x.col(i) - predicted_.col(i)) / model.inverse_mass[i] - impulse_.col(i)) / h2;
+      force_.col(i) = force;
+      pressed_.push_back(i);
       const double pressing = force.dot(contact.normal);
       if (!(pressing > 0.0))
       {
@@ -275,6 +281,15 @@ bool ChainContacts::check(const Model& model, const std::vector<SweepRow>& rows,
     }
   });
   return changed;
+}
+
+void ChainContacts::report(const Model& model, double h, const NodeArray& x, ContactQuery& contacts) const
+{
+  for (const int i : pressed_)
+  {
+    const NodeContact& contact = contact_[static_cast<std::size_t>(i)];
+    contacts.receive(contact, x.col(i) - model.contact_radius[i] * contact.normal, -h * force_.col(i));
+  }
 }
 
 }  // namespace soft_body_sim

@@ -67,6 +67,11 @@ public:
   bool check(const Model& model, const std::vector<SweepRow>& rows, std::size_t first_row, double* lambda,
              const NodeArray& start, double h, const NodeArray& x);
 
+  /// After the last check of a sub-step of h [s] (the chains at `x`): every node held in the last solve
+  /// tells its collider the opposite of its contact force F times h (the class comment), at the surface
+  /// point under it (ContactQuery::receive).
+  void report(const Model& model, double h, const NodeArray& x, ContactQuery& contacts) const;
+
   /// Puts every free node of the chains where the current holds put it (the prediction for a free one),
   /// and sets the sliding ones' kinetic friction.
   void place(const Model& model, const NodeArray& start, double h, NodeArray& x);
@@ -99,6 +104,8 @@ private:
   std::vector<NodeContact> contact_;  ///< per node: its surface at x~ (held nodes)
   NodeArray slip_;                    ///< per node: the unit direction a sliding node slips in
   NodeArray impulse_;                 ///< per node: J^T lambda, the rows' impulses times h [kg m]
+  std::vector<int> pressed_;          ///< the nodes held in the last checked solve
+  NodeArray force_;                   ///< per node: F [N] of the last check, for the nodes in pressed_
 };
 
 }  // namespace soft_body_sim

@@ -34,7 +34,7 @@ void IntegratorGroups::prepare(const Model& model)
 }
 
 void IntegratorGroups::step(const Model& model, State& state, double h, int iterations,
-                            const ContactQuery* contacts)
+                            ContactQuery* contacts)
 {
   if (groups_.empty())
     integrator_->stepWithContacts(model, state, h, iterations, contacts);

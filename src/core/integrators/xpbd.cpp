@@ -62,7 +62,7 @@ public:
   }
 
   void stepWithContacts(const Model& model, State& state, double h, int iterations,
-                        const ContactQuery* contacts) override
+                        ContactQuery* contacts) override
   {
     preSolve(model, state, h);
     solve(model, state.position, h, iterations, contacts);
@@ -102,7 +102,7 @@ private:
     }
   }
 
-  void solve(const Model& model, NodeArray& x, double h, int iterations, const ContactQuery* contacts)
+  void solve(const Model& model, NodeArray& x, double h, int iterations, ContactQuery* contacts)
   {
     const std::size_t row_count = model.springs.size() + model.constraints.size();
     // The partition into chains depends on which nodes are pinned (modelChanged() follows World::attach
@@ -164,6 +164,8 @@ private:
       for (int iteration = 0; iteration < iterations; ++iteration)
         solveChains(model, h, held, iteration, true, x);
     }
+    if (held)
+      chain_contacts_.report(model, h, x, *contacts);
     if (chained)
       correction_ = x - predicted_;
     // The chains' tensions T = -lambda / h^2 [N] (lambda < 0 pulls the ends together), for the next

@@ -21,6 +21,7 @@ struct Plane
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();  ///< normal pointing into free space (need not be unit; not 0)
   double restitution = 0.0;                           ///< normal speed kept after a bounce, in [0, 1]
   double friction = 0.0;                              ///< Coulomb coefficient [-], >= 0
+  std::string name{};  ///< names its wrench (World::colliderWrenches, about `point`); empty: none reported
 };
 
 /// Where a rigid collider is and how it moves, and its surface. Its pose moves at constant `velocity`

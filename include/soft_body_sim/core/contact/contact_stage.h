@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "soft_body_sim/core/holding/reactions.h"
 #include "soft_body_sim/core/integrators/integrator.h"
 #include "soft_body_sim/core/model.h"
 
@@ -61,6 +62,32 @@ struct RigidPose
 /// Where a collider should be at simulated time t [s]; nullopt = not known (it then holds still).
 using ColliderPath = std::function<std::optional<RigidPose>(double t)>;
 
+/// The force [N] and torque [N m] that the bodies exerted on a named collider, averaged over the last step
+/// (the contact impulses it received in the step's sub-steps over dt), torque about its origin, both in
+/// the scene frame (World::colliderWrenches).
+struct ColliderWrench
+{
+  std::string name;
+  Wrench wrench;
+};
+
+/// What one collider received from the bodies since the step began: the sum of the contact impulses
+/// [N s] and of their moments about its origin [N m s].
+struct ReceivedImpulse
+{
+  Vec3 linear = Vec3::Zero();
+  Vec3 angular = Vec3::Zero();
+
+  /// An impulse [N s] at `arm` [m] from the collider's origin.
+  void add(const Vec3& arm, const Vec3& impulse)
+  {
+    linear += impulse;
+    angular += arm.cross(impulse);
+  }
+  /// Their mean force and torque over a step of dt [s].
+  Wrench over(double dt) const { return Wrench{ linear / dt, angular / dt }; }
+};
+
 /// One kind of collider, over all of its shapes in the model.
 class ColliderKind
 {
@@ -70,12 +97,22 @@ public:
   /// by h and resolves the contacts of every free node with them. True if it touched any node (the
   /// integrators' caches of the state are then stale).
   virtual bool resolve(const Model& model, const NodeArray& start, State& state, double h) = 0;
-  /// ContactQuery::touching over its shapes (as they are before this sub-step's resolve moves them).
+  /// ContactQuery::touching over its shapes (as they are before this sub-step's resolve moves them);
+  /// the contact's `collider` is its shape's index among its own.
   virtual bool touching(const Model& /*model*/, int /*node*/, const Vec3& /*x*/, double /*margin*/,
                         NodeContact& /*contact*/) const
   {
     return false;
   }
+  /// How many shapes it has (ContactStage numbers every kind's shapes in turn).
+  virtual std::size_t count() const = 0;
+  /// Its shape `shape` received `impulse` [N s] at `point` [m] from a solve (ContactQuery::receive).
+  virtual void receive(std::size_t shape, const Vec3& point, const Vec3& impulse) = 0;
+  /// At a step's start: the impulses its shapes received are forgotten.
+  virtual void clearImpulses() = 0;
+  /// Appends, per named shape in its order, the impulses received since clearImpulses as a mean wrench
+  /// over dt [s] (ColliderWrench).
+  virtual void appendWrenches(double dt, std::vector<ColliderWrench>& wrenches) const = 0;
   /// Appends the current pose of each of its drawable shapes (planes are infinite: none).
   virtual void appendPoses(std::vector<ColliderPose>& /*poses*/) const {}
   /// Moves its shape `name` to `goal` over the next dt [s] at constant linear and angular velocity (its
@@ -95,22 +132,63 @@ std::vector<std::unique_ptr<ColliderKind>> makeColliderKinds(const Model& model)
 class ContactStage final : public ContactQuery
 {
 public:
-  explicit ContactStage(const Model& model) : kinds_(makeColliderKinds(model)) {}
+  explicit ContactStage(const Model& model) : kinds_(makeColliderKinds(model))
+  {
+    std::size_t first = 0;
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+    {
+      first_.push_back(first);
+      first += kind->count();
+    }
+  }
 
-  /// What the integrators' solves may ask (null without colliders: they pay nothing).
-  const ContactQuery* query() const { return kinds_.empty() ? nullptr : this; }
+  /// What the integrators' solves may ask and tell (null without colliders: they pay nothing).
+  ContactQuery* query() { return kinds_.empty() ? nullptr : this; }
 
+  /// The deepest contact over every kind; its `collider` numbers the kinds' shapes in turn.
   bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const override
   {
     bool found = false;
     NodeContact candidate;
-    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
-      if (kind->touching(model, node, x, margin, candidate) && (!found || candidate.depth > contact.depth))
+    for (std::size_t k = 0; k < kinds_.size(); ++k)
+      if (kinds_[k]->touching(model, node, x, margin, candidate) && (!found || candidate.depth > contact.depth))
       {
         contact = candidate;
+        contact.collider += static_cast<int>(first_[k]);
         found = true;
       }
     return found;
+  }
+
+  void receive(const NodeContact& contact, const Vec3& point, const Vec3& impulse) override
+  {
+    if (contact.collider < 0)
+      return;
+    const auto collider = static_cast<std::size_t>(contact.collider);
+    for (std::size_t k = kinds_.size(); k-- > 0;)
+      if (collider >= first_[k])
+      {
+        kinds_[k]->receive(collider - first_[k], point, impulse);
+        return;
+      }
+  }
+
+  /// At a step's start, for a step of dt [s]: the colliders' impulses start from zero.
+  void beginStep(double dt)
+  {
+    dt_ = dt;
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      kind->clearImpulses();
+  }
+
+  /// Per named collider (planes, spheres, capsules, boxes, cylinders, meshes, each in declaration order),
+  /// the mean wrench the bodies exerted on it over the last step (ColliderWrench); zero before the first.
+  std::vector<ColliderWrench> wrenches() const
+  {
+    std::vector<ColliderWrench> wrenches;
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      kind->appendWrenches(dt_, wrenches);
+    return wrenches;
   }
 
   /// Before a sub-step's integration: keeps where the nodes start (friction acts on the sub-step's
@@ -174,6 +252,8 @@ public:
 
 private:
   std::vector<std::unique_ptr<ColliderKind>> kinds_;
+  std::vector<std::size_t> first_;  ///< per kind: the number of its first shape (NodeContact::collider)
+  double dt_ = 1.0;                 ///< [s] the step the impulses were received in
   NodeArray start_;  ///< positions before the current sub-step's integration [m]
   std::vector<std::pair<std::string, ColliderPath>> paths_;
 };

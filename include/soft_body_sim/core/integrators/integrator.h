@@ -36,6 +36,7 @@ struct NodeContact
   Vec3 velocity;          ///< [m/s] of the surface point (0 for a fixed collider)
   double friction = 0.0;  ///< Coulomb coefficient [-]
   double depth = 0.0;     ///< [m] how far the node is inside its contact radius (< 0: that far outside it)
+  int collider = -1;      ///< which collider it is, for ContactQuery::receive (-1: none)
 };
 
 /// The colliders as a solve can ask about them (the contact stage, contact_stage.h).
@@ -46,6 +47,9 @@ public:
   /// The surface nearest to node `node` placed at `x` [m], if it is within the node's contact radius
   /// plus `margin` [m] of one; the deepest if several are.
   virtual bool touching(const Model& model, int node, const Vec3& x, double margin, NodeContact& contact) const = 0;
+  /// A solve that took `contact` into itself gave its node a contact impulse: the collider receives the
+  /// opposite, `impulse` [N s], at `point` [m] (World::colliderWrenches).
+  virtual void receive(const NodeContact& contact, const Vec3& point, const Vec3& impulse) = 0;
 };
 
 /// The forces inside the bodies in the last sub-step, as an integrator's solve had them.
@@ -63,9 +67,11 @@ public:
   /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
   virtual void step(const Model& model, State& state, double h, int iterations) = 0;
   /// step(), where the scene has colliders (`contacts`; null: none). A solve that can take contacts into
-  /// it does (xpbd's chains: chain_contacts.h); the others leave them to the contact stage that follows.
+  /// it does (xpbd's chains: chain_contacts.h; implicit Euler's solids: collider_holds.h) and hands the
+  /// impulses it gave back to `contacts` (ContactQuery::receive); the others leave them to the contact
+  /// stage that follows.
   virtual void stepWithContacts(const Model& model, State& state, double h, int iterations,
-                                const ContactQuery* /*contacts*/)
+                                ContactQuery* /*contacts*/)
   {
     step(model, state, h, iterations);
   }

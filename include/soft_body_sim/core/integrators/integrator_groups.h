@@ -32,7 +32,7 @@ public:
   void prepare(const Model& model);
   /// Advances every free node of `state` by one sub-step h [s], among the colliders `contacts` (null:
   /// none).
-  void step(const Model& model, State& state, double h, int iterations, const ContactQuery* contacts);
+  void step(const Model& model, State& state, double h, int iterations, ContactQuery* contacts);
 
   /// The forces inside the bodies in the last sub-step, each link's and cell's by the integrator stepping it
   /// (Integrator::internalForces); one between two groups by the last of them.

@@ -37,13 +37,11 @@ void ColliderHolds::assemble(const NewtonPoint& point, const ContactQuery& conta
     d += c.scaled * (n * n.transpose());
     // A hold that pulled in the last step (< 0) adds nothing: only the approach's force presses then.
     const double normal_force = std::max(block * c.depth / (h * h), hold_force_[static_cast<std::size_t>(i)]);
-    Vec3 tangential;
-    const double damping =
-        frictionDamping(c.contact.friction, normal_force, point.v.col(i) - c.contact.velocity, n, tangential);
-    if (!(damping > 0.0))
+    c.damping = frictionDamping(c.contact.friction, normal_force, point.v.col(i) - c.contact.velocity, n, c.slip);
+    if (!(c.damping > 0.0))
       continue;
-    rhs.col(i) -= h * damping * tangential;
-    d += h * damping * (Eigen::Matrix3d::Identity() - n * n.transpose());
+    rhs.col(i) -= h * c.damping * c.slip;
+    d += h * c.damping * (Eigen::Matrix3d::Identity() - n * n.transpose());
   }
 }
 
@@ -62,7 +60,7 @@ void ColliderHolds::find(const NewtonPoint& point, const ContactQuery& contacts)
       continue;
     const double depth = contact.depth + point.h * contact.velocity.dot(contact.normal);
     if (depth > (hold_force_[static_cast<std::size_t>(i)] < 0.0 ? 0.0 : -margin))
-      holds_.push_back({ i, contact, predicted, depth, depth, 0.0 });
+      holds_.push_back({ i, contact, predicted, depth, depth, 0.0, 0.0, Vec3::Zero() });
   }
 }
 
@@ -77,11 +75,22 @@ void ColliderHolds::letGoPulling(double h, const NodeArray& dv)
                holds_.end());
 }
 
-void ColliderHolds::noteForces(double h, const NodeArray& dv)
+void ColliderHolds::noteForces(const Model& model, double h, const NodeArray& dv, ContactQuery& contacts)
 {
   std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
   for (const Hold& c : holds_)
-    hold_force_[static_cast<std::size_t>(c.node)] = force(c, h, dv);
+  {
+    const double normal_force = force(c, h, dv);
+    hold_force_[static_cast<std::size_t>(c.node)] = normal_force;
+    // The force the solve's rows applied (assemble): k (d - h n . dv) along n, and the friction damping's
+    // -c (v_t + (I - n n^T) dv) across it; the collider takes the opposite impulse over h, at the surface
+    // point under the node.
+    const Vec3 n = c.contact.normal;
+    const Vec3 across = dv.col(c.node) - n.dot(dv.col(c.node)) * n;
+    const Vec3 on_node = normal_force * n - c.damping * (c.slip + across);
+    const Vec3 point = c.found_at - (model.contact_radius[c.node] - c.found_depth) * n;
+    contacts.receive(c.contact, point, -h * on_node);
+  }
 }
 
 }  // namespace soft_body_sim

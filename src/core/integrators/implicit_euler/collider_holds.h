@@ -44,8 +44,9 @@ public:
   /// it pulled (< 0) the node is held in the next step only if it is carried into the surface, where it
   /// pushed it is the normal force of the node's friction in the next step (a node resting on the surface,
   /// whose predicted depth is about 0, presses on it with its share of the weight). Every other solid node
-  /// may be held again, with no force known.
-  void noteForces(double h, const NodeArray& dv);
+  /// may be held again, with no force known. Each hold's collider receives the opposite of the impulse
+  /// its rows gave the node, friction's included (ContactQuery::receive).
+  void noteForces(const Model& model, double h, const NodeArray& dv, ContactQuery& contacts);
 
 private:
   struct Hold
@@ -56,6 +57,8 @@ private:
     double found_depth;   ///< [m] its depth then, at the step's end (the surface moved on by h v_s)
     double depth;         ///< d [m] at the step's end, the node at this iteration's predicted position
     double scaled;        ///< h^2 k [kg] in this iteration
+    double damping;       ///< c [kg/s] of its friction in this iteration (frictionDamping)
+    Vec3 slip;            ///< v_t [m/s] that friction damped in this iteration
   };
   void find(const NewtonPoint& point, const ContactQuery& contacts);
   /// k (d - h n . dv) [N]: the force `hold` took in the Newton iteration that solved dv (> 0 pushing).

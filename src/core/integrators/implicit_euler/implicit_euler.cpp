@@ -52,7 +52,7 @@ public:
   void modelChanged() override { analyzed_ = false; }
 
   /// Solids (nodes of tetrahedra) feel the colliders inside the solve (collider_holds.h).
-  void stepWithContacts(const Model& model, State& state, double h, int iterations, const ContactQuery* contacts) override
+  void stepWithContacts(const Model& model, State& state, double h, int iterations, ContactQuery* contacts) override
   {
     contacts_ = model.tetrahedra.empty() ? nullptr : contacts;
     step(model, state, h, iterations);
@@ -96,7 +96,7 @@ public:
       }
     }
     if (contacts_ != nullptr)
-      collider_holds_.noteForces(h, delta_v_);
+      collider_holds_.noteForces(model, h, delta_v_, *contacts_);
     surface_holds_.noteForces(h, delta_v_);
     for (int i = 0; i < n; ++i)
       if (model.isFree(i))
@@ -189,7 +189,7 @@ private:
   bool analyzed_ = false;  ///< the system holds the pattern of the current model
   NodeArray start_x_, start_v_, linear_x_, offset_;
   NodeArray delta_v_;
-  const ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
+  ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
 };
 }  // namespace
 
