@@ -99,6 +99,22 @@ TEST(FaceGeometry, ATrianglesNearestDistanceToACylinderAgreesWithSampling)
   expectTheSampledDistance(Cylinder{ {}, radius, 0.15 }, radius * (1.0 - std::cos(M_PI / kRimSides)));
 }
 
+// A cloth meets colliders with its triangles only when its scene asks (`face_contacts: true`): two per
+// square then, none by default.
+TEST(FaceContactsKey, AClothHasTwoContactTrianglesPerSquareOnlyWhenItAsks)
+{
+  for (const bool faces : { false, true })
+  {
+    const World world = buildWorld(parseScene("bodies:\n"
+                                              "  - {name: cloth, type: cloth, nx: 4, ny: 3, mass: 0.1,\n"
+                                              "     top_left: [0, 0, 1], top_right: [0.3, 0, 1], bottom_left: [0, 0.2, 1],\n"
+                                              "     structural: {stiffness: 100}, shear: {stiffness: 10},\n"
+                                              "     face_contacts: " + std::string(faces ? "true" : "false") + "}\n",
+                                              "key.yaml"));
+    EXPECT_EQ(world.model().contact_triangles.size(), faces ? 2u * 3u * 2u : 0u);
+  }
+}
+
 // --- a finger through a hanging cloth ------------------------------------------------------------------
 
 /// A 1 m cloth of 21 x 21 nodes (5 cm spacing, 5 mm thick) hanging in the x-z plane at y = 0 from its top
@@ -120,6 +136,7 @@ SceneDef hangingClothAndFinger(const std::string& integrator, int substeps)
                         "    bottom_left: [0.0, 0.0, 0.5]\n"
                         "    mass: 0.3\n"
                         "    thickness: 0.005\n"
+                        "    face_contacts: true\n"
                         "    structural: {stiffness: 1000.0, damping: 0.02}\n"
                         "    shear: {stiffness: 200.0, damping: 0.01}\n"
                         "    bending: {stiffness: 20.0, damping: 0.0}\n"
@@ -223,6 +240,7 @@ SceneDef droppedCloth(const std::string& integrator, int substeps, const std::st
                         "    bottom_left: [-0.5, " + number(y0 - 0.5) + ", " + number(z) + "]\n"
                         "    mass: 0.3\n"
                         "    thickness: 0.005\n"
+                        "    face_contacts: true\n"
                         "    structural: {stiffness: 1000.0, damping: 0.02}\n"
                         "    shear: {stiffness: 200.0, damping: 0.01}\n"
                         "    bending: {stiffness: 20.0, damping: 0.0}\n",

@@ -115,7 +115,7 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   const auto node = [nx](int i, int j) { return j * nx + i; };
   // Two triangles per square, split along the diagonal from (i, j) to (i + 1, j + 1), meet colliders
   // over their faces and edges (face_contacts.h).
-  for (int j = 0; j + 1 < ny; ++j)
+  for (int j = 0; cloth.face_contacts && j + 1 < ny; ++j)
     for (int i = 0; i + 1 < nx; ++i)
     {
       body.contact_triangles.push_back({ node(i, j), node(i + 1, j), node(i + 1, j + 1) });

@@ -7,7 +7,7 @@ BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& 
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass",
                                               "structural", "shear", "bending", "pinned", "thickness",
-                                              "self_collision", "self_friction" }));
+                                              "self_collision", "self_friction", "face_contacts" }));
   ClothDef cloth;
   cloth.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 2);
   const Field ny = requiredKey(ctx, field, "ny");
@@ -23,6 +23,7 @@ BodyDef readClothBody(const Context& ctx, const Field& field, const SceneSoFar& 
     cloth.pinned = readPinned(ctx, *value, cloth.nx * cloth.ny, cloth.nx, cloth.ny);
   readOptional(ctx, field, "thickness", cloth.thickness, readNumber);
   readSelfContact(ctx, field, cloth);
+  readOptional(ctx, field, "face_contacts", cloth.face_contacts, readBool);
   return buildBody(ctx, field, cloth, buildCloth);
 }
 
