@@ -1,5 +1,5 @@
-// A surface's triangles against a collider: where a thin shape touches a cloth, a jelly or a solid between
-// its nodes. Private to the core.
+// A cloth's triangles against a collider (`face_contacts: true`): where a thin shape touches a cloth
+// between its nodes. Private to the core.
 //
 // Two convex bodies come closest, or overlap deepest, at a corner of one against a face of the other or at
 // an edge against an edge. A triangle's corners are nodes, which meet the shape's exact surface already
@@ -23,10 +23,10 @@
 #include <optional>
 #include <vector>
 
-#include "core/contact/closest_points.h"
-#include "soft_body_sim/core/contact/colliders.h"
 #include <Eigen/Geometry>
 
+#include "core/contact/closest_points.h"
+#include "soft_body_sim/core/contact/colliders.h"
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
