@@ -30,7 +30,7 @@ std::vector<Vec3> trianglePoints(const TriangleCorners& t, int divisions)
 
 /// The nearest distance [m] of triangle t to the shape's surface from its features (face_contacts.h) and
 /// its corners' own distances: faceTouch with a contact radius far beyond the triangle says how far inside
-/// it each feature's surface reaches, at rest (start = end, no known side).
+/// it each feature's surface reaches, at rest (start = end).
 template <typename Shape>
 double featureDistance(const Shape& shape, const TriangleCorners& t)
 {
@@ -39,7 +39,7 @@ double featureDistance(const Shape& shape, const TriangleCorners& t)
     least = std::min(least, surfaceDistance(shape, corner).distance);
   constexpr double kFar = 10.0;
   for (const ShapeFeature& f : shapeFeatures(shape))
-    if (const std::optional<FaceTouch> touch = faceTouch(f, f, t, t, kFar, kFar, 0))
+    if (const std::optional<FaceTouch> touch = faceTouch(f, f, t, t, kFar, kFar))
       least = std::min(least, kFar - touch->depth);
   return least;
 }

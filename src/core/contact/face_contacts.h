@@ -145,30 +145,22 @@ struct TriangleBall
   /// straight from its start to its end (relative to each other).
   bool meets(const Vec3& p, const Vec3& p_then, double reach) const
   {
-    double gap2;
-    return meets(p, p_then, reach, gap2);
-  }
-
-  /// As above, with the least squared distance [m^2] between the point and the centre on the way.
-  bool meets(const Vec3& p, const Vec3& p_then, double reach, double& gap2) const
-  {
     const Vec3 offset = centre - p, offset_then = centre_then - p_then;
     const Vec3 path = offset - offset_then;
     const double length2 = path.squaredNorm();
     const double s = length2 > 0.0 ? std::clamp(-offset_then.dot(path) / length2, 0.0, 1.0) : 0.0;
     const double within = reach + size;
-    gap2 = (offset_then + s * path).squaredNorm();
-    return gap2 <= within * within;
+    return (offset_then + s * path).squaredNorm() <= within * within;
   }
 
   /// Whether feature f (f_then at the start), thickened by `thickness` [m] more, comes within the ball, its
-  /// point nearest to the ball's centre followed through the sub-step; `gap2` as for meets.
-  bool meetsSegment(const ShapeFeature& f, const ShapeFeature& f_then, double thickness, double& gap2) const
+  /// point nearest to the ball's centre followed through the sub-step.
+  bool meetsSegment(const ShapeFeature& f, const ShapeFeature& f_then, double thickness) const
   {
     const Vec3 d = f.b - f.a;
     const double length2 = d.squaredNorm();
     const double s = length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0;
-    return meets(f.a + s * d, f_then.a + s * (f_then.b - f_then.a), f.radius + thickness, gap2);
+    return meets(f.a + s * d, f_then.a + s * (f_then.b - f_then.a), f.radius + thickness);
   }
 
   Vec3 centre;
@@ -244,8 +236,7 @@ inline double relativeMotion(const ShapeFeature& f, const ShapeFeature& f_start,
 ///   out where it is nearest, which past a thin shape's middle is its far side); the edge's point moves
 ///   that way.
 inline std::optional<FaceTouch> faceTouch(const ShapeFeature& f, const ShapeFeature& f_start, const TriangleCorners& t,
-                                          const TriangleCorners& t_start, double thickness, double face_thickness,
-                                          int known_side)
+                                          const TriangleCorners& t_start, double thickness, double face_thickness)
 {
   const double corner_reach = f.radius + thickness, reach = f.radius + face_thickness;
   const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
@@ -263,9 +254,7 @@ inline std::optional<FaceTouch> faceTouch(const ShapeFeature& f, const ShapeFeat
     const double mid = 0.5 * (lo + hi);
     const Vec3 n_start = (t_start[1] - t_start[0]).cross(t_start[2] - t_start[0]);
     const double h_start = n_start.dot(f_start.a + mid * (f_start.b - f_start.a) - t_start[0]);
-    const double side = known_side != 0 ? known_side
-                        : h_start != 0.0 ? std::copysign(1.0, h_start)
-                                         : std::copysign(1.0, h_lo + h_hi);
+    const double side = h_start != 0.0 ? std::copysign(1.0, h_start) : std::copysign(1.0, h_lo + h_hi);
     const bool low = side * h_lo <= side * h_hi;
     const double height = side * (low ? h_lo : h_hi);
     const double at = low ? lo : hi;
@@ -295,10 +284,6 @@ inline std::optional<FaceTouch> faceTouch(const ShapeFeature& f, const ShapeFeat
     if (!(length > 0.0))
       continue;
     away /= length;
-    // Past the face's plane from the side the shape is known to be on: back the way it came.
-    const double across = known_side * away.dot(unit);
-    if (across > 0.0)
-      away -= 2.0 * across * known_side * unit;
     Vec3 weight = Vec3::Zero();
     weight[k] = 1.0 - u;
     weight[next] = u;

@@ -185,7 +185,6 @@ public:
       placeFeatures(features_now_);
       placeGroups(group_centres_now_, group_centres_then_);
       boxTriangles(model, start, state.position);
-      sides_.resize(model.contact_triangles.size() * shapes_.size(), 0);
       touched_features_.clear();
       for (std::size_t t = 0; t < model.contact_triangles.size(); ++t)
         resolveTriangle(model, start, state, h, t);
@@ -370,17 +369,11 @@ private:
     {
       if (!placed_[k] || features_[k].empty())
         continue;
-      std::int8_t& side = sides_[index * shapes_.size() + k];
       if (!triangle_boxes_[index].intersects(shape_boxes_[k]))
-      {
-        side = 0;
         continue;
-      }
       if (!ball)
         ball.emplace(corners(), then);
       bool touched_shape = false;
-      const ShapeFeature* nearest = nullptr;  // of those near the triangle
-      double least = 1e300;
       for (std::size_t g = 0; g < groups_[k].size(); ++g)
       {
         const FeatureGroup& group = groups_[k][g];
@@ -388,15 +381,8 @@ private:
           continue;
         for (std::size_t f = group.first; f < group.last; ++f)
         {
-          const ShapeFeature& now = features_now_[k][f];
-          double gap2;
-          if (!ball->meetsSegment(now, start_features_[k][f], thickness, gap2))
+          if (!ball->meetsSegment(features_now_[k][f], start_features_[k][f], thickness))
             continue;
-          if (gap2 < least)
-          {
-            least = gap2;
-            nearest = &now;
-          }
           const TouchedFeature feature{ index, k, f };
           if (touchFeature(model, start, state, h, feature))
           {
@@ -405,12 +391,6 @@ private:
           }
         }
       }
-      // The side a shape is on is remembered from a sub-step where it came near without touching; with
-      // none near, it is not known (faceTouch then takes it from the sub-step's start).
-      if (!nearest)
-        side = 0;
-      else if (!touched_shape)
-        side = sideOf(*nearest, corners());
       if (touched_shape)
       {
         touched = true;
@@ -420,8 +400,8 @@ private:
     return touched;
   }
 
-  /// Feature f of shape k against contact triangle `triangle` (faceTouch, on the side sides_ knows): true
-  /// if it touched, and the triangle was pushed.
+  /// Feature f of shape k against contact triangle `triangle` (faceTouch): true if it touched, and the
+  /// triangle was pushed.
   bool touchFeature(const Model& model, const NodeArray& start, State& state, double h, const TouchedFeature& touched)
   {
     const std::array<int, 3>& triangle = model.contact_triangles[touched.triangle];
@@ -431,7 +411,7 @@ private:
         features_now_[touched.shape][touched.feature], start_features_[touched.shape][touched.feature],
         TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]), state.position.col(triangle[2]) },
         TriangleCorners{ start.col(triangle[0]), start.col(triangle[1]), start.col(triangle[2]) }, thickness,
-        kFaceSag * thickness, sides_[touched.triangle * shapes_.size() + touched.shape]);
+        kFaceSag * thickness);
     return touch && pushTriangle(model, start, state, h, triangle, *touch, touched.shape);
   }
 
@@ -468,17 +448,6 @@ private:
     }
     push(k, touch.contact, -moved_mass * (v - v0));
     return true;
-  }
-
-  /// The side of triangle t (+1: along its normal (t1 - t0) x (t2 - t0), -1: against it) where feature
-  /// f's point nearest to its centre lies.
-  static std::int8_t sideOf(const ShapeFeature& f, const TriangleCorners& t)
-  {
-    const Vec3 centre = (t[0] + t[1] + t[2]) / 3.0;
-    const Vec3 d = f.b - f.a;
-    const double length2 = d.squaredNorm();
-    const Vec3 p = f.a + (length2 > 0.0 ? std::clamp((centre - f.a).dot(d) / length2, 0.0, 1.0) : 0.0) * d;
-    return (t[1] - t[0]).cross(t[2] - t[0]).dot(p - centre) >= 0.0 ? 1 : -1;
   }
 
   /// Each contact triangle's axis-aligned bounding box over the sub-step (its corners at its start and
@@ -598,9 +567,6 @@ private:
   std::vector<std::vector<ShapeFeature>> features_;  ///< per shape: its features in its own frame
   /// per shape: its features in the scene frame at the start of the current sub-step and now
   std::vector<std::vector<ShapeFeature>> start_features_, features_now_;
-  /// per contact triangle and shape: the side of the triangle the shape was on when they last came near
-  /// without touching (sideOf; 0: not near then)
-  std::vector<std::int8_t> sides_;
   std::vector<TouchedFeature> touched_features_;  ///< those of this sub-step's first sweep
   std::vector<std::vector<FeatureGroup>> groups_;  ///< per shape: its features in groups, for the search
   std::vector<std::vector<Vec3>> group_centres_now_, group_centres_then_;  ///< placeGroups

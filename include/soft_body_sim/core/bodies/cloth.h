@@ -64,8 +64,8 @@ struct ClothDef
   double self_friction = 0.0;  ///< Coulomb coefficient [-] between touching nodes, >= 0
   /// Its triangles (two per square) meet spheres, capsules, boxes and cylinders over their faces and
   /// edges, not only at its nodes (face_contacts.h): a finger or rail thinner than the node spacing does
-  /// not pass between them. Off by default: a fine cloth (2 cm spacing) falling onto a bar of 5 cm
-  /// radius at 2 m/s is thrown apart by them (measured), which is not understood yet.
+  /// not pass between them. Off by default, experimental: at one sub-step of 1/60 s a 5 cm cloth dropped
+  /// onto a ball of 15 cm radius is thrown apart (at four it rests).
   bool face_contacts = false;
 };
 
