@@ -97,6 +97,27 @@ RopeDef ropeOver(const Capsule& bar)
   rope.radius = 0.005;
   return rope;
 }
+
+/// ropeOver a horizontal capsule "bar" of radius 3 cm and length 0.3 m along y at height 1 m (friction
+/// 0.5), damped to come to rest: 1/240 s in 4 sub-steps of 4 iterations, drag 5.
+SceneDef ropeOverBar(IntegratorType integrator)
+{
+  SceneDef scene;
+  scene.physics.integrator = integrator;
+  scene.physics.step = StepSettings{ 1.0 / 240.0, 4, 4 };
+  scene.physics.gravity = Vec3(0.0, 0.0, -kGravity);
+  scene.physics.drag = 5.0;
+  Capsule bar;
+  bar.at.name = "bar";
+  bar.radius = 0.03;
+  bar.length = 0.3;
+  bar.at.position = Vec3(0.0, 0.0, 1.0);
+  bar.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * kPi, Vec3::UnitX()));  // along y
+  bar.at.friction = 0.5;
+  scene.colliders.capsules.push_back(bar);
+  scene.bodies.push_back(buildRope("rope", ropeOver(bar)));
+  return scene;
+}
 }  // namespace
 
 TEST(ColliderWrenches, ASoftSolidRestingOffCentreOnATablePressesWithItsWeightThroughItsCentreOfMass)
@@ -139,21 +160,7 @@ TEST(ColliderWrenches, ARopeHangingOverACapsuleLoadsItWithTheRopesWeight)
   for (const IntegratorType integrator : { IntegratorType::Xpbd, IntegratorType::ImplicitEuler })
   {
     SCOPED_TRACE(integratorName(integrator));
-    SceneDef scene;
-    scene.physics.integrator = integrator;
-    scene.physics.step = StepSettings{ 1.0 / 240.0, 4, 4 };
-    scene.physics.gravity = Vec3(0.0, 0.0, -kGravity);
-    scene.physics.drag = 5.0;
-    Capsule bar;
-    bar.at.name = "bar";
-    bar.radius = 0.03;
-    bar.length = 0.3;
-    bar.at.position = Vec3(0.0, 0.0, 1.0);
-    bar.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * kPi, Vec3::UnitX()));  // along y
-    bar.at.friction = 0.5;
-    scene.colliders.capsules.push_back(bar);
-    scene.bodies.push_back(buildRope("rope", ropeOver(bar)));
-    World world = buildWorld(scene);
+    World world = buildWorld(ropeOverBar(integrator));
     ASSERT_TRUE(comeToRest(world, 0.5));
     world.step();
     const double weight = 0.042 * kGravity;
@@ -165,20 +172,7 @@ TEST(ColliderWrenches, ARopeCarryingTwoLoadsOverACapsuleUnderXpbdLoadsItWithItsA
 {
   // As above with 0.2 kg at both ends: xpbd solves the loaded rope as a chain, its nodes on the capsule held
   // inside that solve (chain_contacts.h), which then tells the capsule the contact forces it applied.
-  SceneDef scene;
-  scene.physics.integrator = IntegratorType::Xpbd;
-  scene.physics.step = StepSettings{ 1.0 / 240.0, 4, 4 };
-  scene.physics.gravity = Vec3(0.0, 0.0, -kGravity);
-  scene.physics.drag = 5.0;
-  Capsule bar;
-  bar.at.name = "bar";
-  bar.radius = 0.03;
-  bar.length = 0.3;
-  bar.at.position = Vec3(0.0, 0.0, 1.0);
-  bar.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(0.5 * kPi, Vec3::UnitX()));
-  bar.at.friction = 0.5;
-  scene.colliders.capsules.push_back(bar);
-  scene.bodies.push_back(buildRope("rope", ropeOver(bar)));
+  SceneDef scene = ropeOverBar(IntegratorType::Xpbd);
   scene.bodies[0].nodes.front().mass = 0.2;
   scene.bodies[0].nodes.back().mass = 0.2;
   World world = buildWorld(scene);
