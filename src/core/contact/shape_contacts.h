@@ -97,6 +97,13 @@ constexpr int kTrianglePasses = 4;
 /// into the shape.
 constexpr double kFaceSag = 0.5;
 
+/// A contact triangle's thickness [m]: its nodes' mean contact radius.
+inline double triangleThickness(const Model& model, const std::array<int, 3>& triangle)
+{
+  return (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] + model.contact_radius[triangle[2]]) /
+         3.0;
+}
+
 /// A feature of a shape that touched a contact triangle (ShapeContacts' repeated sweeps).
 struct TouchedFeature
 {
@@ -356,8 +363,7 @@ private:
   bool resolveTriangle(const Model& model, const NodeArray& start, State& state, double h, std::size_t index)
   {
     const std::array<int, 3>& triangle = model.contact_triangles[index];
-    const double thickness = (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] +
-                              model.contact_radius[triangle[2]]) / 3.0;
+    const double thickness = triangleThickness(model, triangle);
     const TriangleCorners then{ start.col(triangle[0]), start.col(triangle[1]), start.col(triangle[2]) };
     const auto corners = [&] {
       return TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]),
@@ -405,8 +411,7 @@ private:
   bool touchFeature(const Model& model, const NodeArray& start, State& state, double h, const TouchedFeature& touched)
   {
     const std::array<int, 3>& triangle = model.contact_triangles[touched.triangle];
-    const double thickness = (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] +
-                              model.contact_radius[triangle[2]]) / 3.0;
+    const double thickness = triangleThickness(model, triangle);
     const std::optional<FaceTouch> touch = faceTouch(
         features_now_[touched.shape][touched.feature], start_features_[touched.shape][touched.feature],
         TriangleCorners{ state.position.col(triangle[0]), state.position.col(triangle[1]), state.position.col(triangle[2]) },
