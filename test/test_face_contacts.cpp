@@ -197,9 +197,10 @@ TEST_P(FingerThroughCloth, AFingerThinnerThanTheSpacingCarriesTheClothBetweenTwo
   EXPECT_GT(nearest_at_rest, radius + kFaceSag * thickness - 1e-9);
 }
 
-// implicit_euler's solve does not yet know the triangles' contacts (they follow it), so its step pulls a
-// taut cloth through the finger unless the sub-steps are short: measured, with 1 sub-step the cloth is
-// through by 1.4 s, with 6 a triangle is pierced while the finger moves, with 8 none is.
+// implicit_euler's solve holds the cloth's nodes on the colliders but not yet its faces (they follow the
+// solve), so its step pulls a taut cloth through a finger between two columns unless the sub-steps are
+// short: measured, with 1 sub-step the cloth is through by 1.4 s, with 6 a triangle is pierced while the
+// finger moves, with 8 none is.
 INSTANTIATE_TEST_SUITE_P(Integrators, FingerThroughCloth,
                          ::testing::Values(FingerCase{ "xpbd", 1 }, FingerCase{ "implicit_euler", 12 }),
                          [](const ::testing::TestParamInfo<FingerCase>& info) { return info.param.integrator; });
@@ -295,9 +296,10 @@ TEST_P(ClothOnARail, AClothDroppedOnARailThinnerThanItsSpacingRestsDrapedOnIt)
 }
 
 // xpbd at one sub-step lets the falling cloth slip round the rail and through (measured: a triangle
-// pierced from 0.3 s on); at 4 it holds, as implicit_euler does at 8.
+// pierced from 0.3 s on); at 4 it holds. implicit_euler holds the nodes on the rail inside its solve
+// (collider_holds.h) and rests at one.
 INSTANTIATE_TEST_SUITE_P(Integrators, ClothOnARail,
-                         ::testing::Values(FingerCase{ "xpbd", 4 }, FingerCase{ "implicit_euler", 8 }),
+                         ::testing::Values(FingerCase{ "xpbd", 4 }, FingerCase{ "implicit_euler", 1 }),
                          [](const ::testing::TestParamInfo<FingerCase>& info) { return info.param.integrator; });
 
 /// The cloth dropped from 10 cm onto `shape` (declared by `yaml`), centred at y0: no point of any of its
@@ -345,10 +347,11 @@ TEST_P(ClothOnShapes, NoPointOfAnyTriangleGoesIntoABallOrABoxEdge)
                          0.7, 0.0);
 }
 
-// At one sub-step of 1/60 s the cloth draped on the ball is thrown off it, under both integrators
-// (measured: nodes at 11 m/s by 0.5 s); at 4 it rests.
+// At one sub-step of 1/60 s xpbd's cloth draped on the ball is torn (measured: links 18 times their length
+// by 1 s; the contacts follow the solve, which stretches the cloth over the ball again in every step); at 4
+// it rests. implicit_euler holds the nodes inside its solve and rests at one.
 INSTANTIATE_TEST_SUITE_P(Integrators, ClothOnShapes,
-                         ::testing::Values(FingerCase{ "xpbd", 4 }, FingerCase{ "implicit_euler", 4 }),
+                         ::testing::Values(FingerCase{ "xpbd", 4 }, FingerCase{ "implicit_euler", 1 }),
                          [](const ::testing::TestParamInfo<FingerCase>& info) { return info.param.integrator; });
 
 }  // namespace

@@ -8,13 +8,16 @@ namespace soft_body_sim
 {
 void ColliderHolds::analyze(const Model& model)
 {
-  solid_node_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
+  held_node_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
   hold_force_.assign(static_cast<std::size_t>(model.nodeCount()), 0.0);
   holds_.clear();
   holds_.reserve(static_cast<std::size_t>(model.nodeCount()));
   for (const Tetrahedron& tet : model.tetrahedra)
     for (const int node : tet.nodes)
-      solid_node_[static_cast<std::size_t>(node)] = 1;
+      held_node_[static_cast<std::size_t>(node)] = 1;
+  for (const std::array<int, 3>& triangle : model.contact_triangles)
+    for (const int node : triangle)
+      held_node_[static_cast<std::size_t>(node)] = 1;
 }
 
 void ColliderHolds::assemble(const NewtonPoint& point, const ContactQuery& contacts, bool first_iteration,
@@ -53,7 +56,7 @@ void ColliderHolds::find(const NewtonPoint& point, const ContactQuery& contacts)
   const double margin = model.gravity.norm() * point.h * point.h;
   for (int i = 0; i < model.nodeCount(); ++i)
   {
-    if (!solid_node_[static_cast<std::size_t>(i)] || !model.isFree(i))
+    if (!held_node_[static_cast<std::size_t>(i)] || !model.isFree(i))
       continue;
     const Vec3 predicted = point.x.col(i) + point.offset.col(i);
     if (!contacts.touching(model, i, predicted, margin, contact))

@@ -51,10 +51,11 @@ public:
 
   void modelChanged() override { analyzed_ = false; }
 
-  /// Solids (nodes of tetrahedra) feel the colliders inside the solve (collider_holds.h).
+  /// Solids (nodes of tetrahedra) and the cloths with face contacts (nodes of contact triangles) feel the
+  /// colliders inside the solve (collider_holds.h).
   void stepWithContacts(const Model& model, State& state, double h, int iterations, ContactQuery* contacts) override
   {
-    contacts_ = model.tetrahedra.empty() ? nullptr : contacts;
+    contacts_ = model.tetrahedra.empty() && model.contact_triangles.empty() ? nullptr : contacts;
     step(model, state, h, iterations);
     contacts_ = nullptr;
   }
@@ -189,7 +190,7 @@ private:
   bool analyzed_ = false;  ///< the system holds the pattern of the current model
   NodeArray start_x_, start_v_, linear_x_, offset_;
   NodeArray delta_v_;
-  ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids
+  ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids or cloths
 };
 }  // namespace
 
