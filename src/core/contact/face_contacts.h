@@ -89,8 +89,11 @@ inline std::vector<ShapeFeature> shapeFeatures(const Cylinder& cylinder)
   return features;
 }
 
-/// A mesh's surface is a distance field: its nodes meet it, its faces not yet.
-inline std::vector<ShapeFeature> shapeFeatures(const Mesh& /*mesh*/) { return {}; }
+/// A mesh's edges where its surface turns outward (convex), and the rims of an open one, at their exact
+/// place (radius 0; the nodes meet the mesh through its distance field). A flat edge (its two triangles in
+/// one plane) or an inward one (the floor of a groove) is left out: the faces beside it, which the nodes
+/// meet, come nearer to any triangle outside the mesh than it does.
+std::vector<ShapeFeature> shapeFeatures(const Mesh& mesh);
 
 /// Consecutive features of a shape [first, last) within `radius` [m] (their own radii included) of
 /// `centre` (in the shape's frame): a triangle beyond that skips them all (a cylinder's rims of 24 edges

@@ -116,7 +116,9 @@ template <typename Shape>
 class ShapeContacts final : public ColliderKind
 {
 public:
-  ShapeContacts(std::vector<Shape> shapes, int nodes)
+  /// `faces`: the model has contact triangles (the shapes' features are made only then: a mesh's take a
+  /// pass over its edges).
+  ShapeContacts(std::vector<Shape> shapes, int nodes, bool faces)
     : shapes_(std::move(shapes))
     , goals_(shapes_.size())
     , touching_(static_cast<std::size_t>(nodes), 0)
@@ -127,7 +129,7 @@ public:
       checkCollider(shape);
       shape.at.orientation.normalize();
       bounds_.push_back(boundingRadius(shape));
-      features_.push_back(shapeFeatures(shape));
+      features_.push_back(faces ? shapeFeatures(shape) : std::vector<ShapeFeature>{});
       groups_.push_back(featureGroups(features_.back()));
       // A shape on a tf frame has no place in the scene until its frame's first pose lands.
       placed_.push_back(shape.at.frame.empty() ? 1 : 0);
