@@ -94,11 +94,17 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   {
     const double spacing = std::min((cloth.corners.top_right - cloth.corners.top_left).norm() / (cloth.nx - 1),
                                     (cloth.corners.bottom_left - cloth.corners.top_left).norm() / (cloth.ny - 1));
-    // A node of radius r passes between four others of radius r at spacing d when d / sqrt(2) >= 2 r.
-    requireDefinition(cloth.thickness >= 0.36 * spacing && cloth.thickness < 0.5 * spacing, what, { "thickness" },
-                      "self_collision needs a thickness from 0.36 to 0.5 times the node spacing (" +
-                          formatNumber(spacing) + " m): thinner, a node slips between four others; thicker, "
-                          "neighbours overlap at rest");
+    // A node of radius r passes between four others of radius r at spacing d when d / sqrt(2) >= 2 r;
+    // faces (face_contacts) close those gaps, and only neighbours overlapping at rest are left.
+    if (cloth.face_contacts)
+      requireDefinition(cloth.thickness < 0.5 * spacing, what, { "thickness" },
+                        "self_collision needs a thickness below 0.5 times the node spacing (" + formatNumber(spacing) +
+                            " m): thicker, neighbours overlap at rest");
+    else
+      requireDefinition(cloth.thickness >= 0.36 * spacing && cloth.thickness < 0.5 * spacing, what, { "thickness" },
+                        "self_collision needs a thickness from 0.36 to 0.5 times the node spacing (" +
+                            formatNumber(spacing) + " m): thinner, a node slips between four others; thicker, "
+                            "neighbours overlap at rest (with face_contacts, any below 0.5)");
   }
   requireSelfContact(what, cloth.self_collision, cloth.self_friction, cloth.thickness, "thickness");
   BodyDef body;

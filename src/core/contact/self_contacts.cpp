@@ -6,6 +6,8 @@
 #include <tuple>
 
 #include "core/contact/closest_points.h"
+#include "core/contact/face_contacts.h"
+#include "core/contact/surface_contacts.h"
 
 namespace soft_body_sim
 {
@@ -99,6 +101,29 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
     has_links[body] = true;
     add(a, b, body);
   }
+  // A cloth with face contacts: its triangles' edges, each once, and its faces.
+  by_faces_.assign(model.bodies.size(), false);
+  std::vector<std::pair<int, int>> edges;
+  for (const std::array<int, 3>& triangle : model.contact_triangles)
+  {
+    const std::size_t body = model.bodyOf(triangle[0]);
+    const double radius =
+        (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] + model.contact_radius[triangle[2]]) / 3.0;
+    if (!model.bodies[body].self_collision || !(radius > 0.0))
+      continue;
+    has_links[body] = true;
+    by_faces_[body] = true;
+    faces_.push_back(triangle);
+    face_body_.push_back(static_cast<int>(body));
+    face_radius_.push_back(radius);
+    face_friction_.push_back(model.bodies[body].self_friction);
+    for (int k = 0; k < 3; ++k)
+      edges.emplace_back(std::min(triangle[k], triangle[(k + 1) % 3]), std::max(triangle[k], triangle[(k + 1) % 3]));
+  }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  for (const auto& [a, b] : edges)
+    add(a, b, model.bodyOf(a));
   // A body without links (a cloth, a jelly) collides by its nodes, each a ball of its contact radius: a
   // segment from the node to itself.
   for (std::size_t body = 0; body < model.bodies.size(); ++body)
@@ -114,9 +139,7 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   }
   for (const BodyRange& body : model.bodies)
     springs_collide_.push_back(body.springs_collide);
-  rest_.resize(3, static_cast<Eigen::Index>(segments_.size()));
-  for (std::size_t k = 0; k < segments_.size(); ++k)
-    rest_.col(static_cast<Eigen::Index>(k)) = rest.col(segments_[k].first);
+  rest_ = rest;
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
   for (const auto& [a, b] : segments_)
@@ -124,11 +147,21 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   std::sort(nodes_.begin(), nodes_.end());
   nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
   skin_ = kSkinRadii * largest_radius_;
+  if (faces_.empty())
+    return;
+  for (const int node : nodes_)
+  {
+    face_items_.emplace_back(node, node);
+    node_radius_.push_back(model.contact_radius[node]);
+    node_body_.push_back(static_cast<int>(model.bodyOf(node)));
+  }
+  for (const std::array<int, 3>& face : faces_)
+    face_items_.emplace_back(face[0], face[1]);
 }
 
 void SelfContacts::remember(const State& state)
 {
-  if (any_friction_)
+  if (any_friction_ || !faces_.empty())
     start_ = state.position;
 }
 
@@ -176,15 +209,21 @@ void SelfContacts::findCandidates(const NodeArray& x)
       // their contact distance at rest (its direct and diagonal neighbours) are held apart by its springs,
       // and come that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute
       // Physics).
+      // A face-contact cloth's edges likewise: those within twice their contact distance at rest.
       const bool ball_s = a == b, ball_t = c == d;
-      if (!ball_s && !ball_t)
+      const std::size_t body = static_cast<std::size_t>(body_[s]);
+      double p, q;
+      if (by_faces_[body])
       {
-        if (springs_collide_[static_cast<std::size_t>(body_[s])] || std::abs(a - c) <= kSkippedLinks)
+        if (contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
           return;
       }
-      else if (ball_s && ball_t &&
-               (rest_.col(static_cast<Eigen::Index>(s)) - rest_.col(static_cast<Eigen::Index>(t))).norm() <
-                   2.0 * (radius_[s] + radius_[t]))
+      else if (!ball_s && !ball_t)
+      {
+        if (springs_collide_[body] || std::abs(a - c) <= kSkippedLinks)
+          return;
+      }
+      else if (ball_s && ball_t && (rest_.col(a) - rest_.col(c)).norm() < 2.0 * (radius_[s] + radius_[t]))
       {
         return;
       }
@@ -199,8 +238,47 @@ void SelfContacts::findCandidates(const NodeArray& x)
     if (contactGap(x, segments_[s], segments_[t], p, q).norm() < within)
       candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
   });
+  findFaceCandidates(x);
   found_at_ = x;
   ++searches_;
+}
+
+void SelfContacts::findFaceCandidates(const NodeArray& x)
+{
+  face_candidates_.clear();
+  if (faces_.empty())
+    return;
+  // A face lies within its longest edge of its first edge's midpoint (the item's place in the grid), a
+  // node at its own: a node and a face within their radii and the skin sit in the same or neighbouring
+  // cells of that width plus the radii and the skin.
+  double longest = 0.0, thickest = 0.0;
+  for (std::size_t f = 0; f < faces_.size(); ++f)
+  {
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (x.col(faces_[f][k]) - x.col(faces_[f][(k + 1) % 3])).norm());
+    thickest = std::max(thickest, face_radius_[f]);
+  }
+  const double widest = *std::max_element(node_radius_.begin(), node_radius_.end());
+  face_grid_.build(x, face_items_, longest + widest + thickest + skin_ + 1e-9);
+  const std::size_t node_count = nodes_.size();
+  face_grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
+    if (!(s < node_count && t >= node_count))
+      return;  // two nodes or two faces: the segments' pairs
+    const int node = nodes_[s];
+    const std::size_t f = t - node_count;
+    const std::array<int, 3>& face = faces_[f];
+    if (node == face[0] || node == face[1] || node == face[2])
+      return;
+    const double reach = node_radius_[s] + face_radius_[f];
+    // A cloth's own node near the face at rest (a corner of the next triangle) is held off by its springs.
+    if (node_body_[s] == face_body_[f] &&
+        (rest_.col(node) - nearestOnTriangle(rest_.col(node), rest_.col(face[0]), rest_.col(face[1]), rest_.col(face[2])).point)
+                .norm() < 2.0 * reach)
+      return;
+    const Vec3 p = x.col(node);
+    if ((p - nearestOnTriangle(p, x.col(face[0]), x.col(face[1]), x.col(face[2])).point).norm() < reach + skin_)
+      face_candidates_.emplace_back(static_cast<std::uint32_t>(node), static_cast<std::uint32_t>(f));
+  });
 }
 
 bool SelfContacts::resolve(const Model& model, State& state)
@@ -282,7 +360,7 @@ bool SelfContacts::resolve(const Model& model, State& state)
       touched = touched || pair.push > 0.0;
     }
   if (!any_friction_ || !touched)
-    return touched;
+    return resolveFaces(model, state) || touched;
   // Coulomb friction as on a collider (contact_response.h), relative to the other link, once the links
   // are apart: the sub-step's tangential slip of the nearest points cancelled up to friction * the push
   // apart, their tangential speed reduced by up to friction * the approach speed removed. After the
@@ -306,6 +384,112 @@ bool SelfContacts::resolve(const Model& model, State& state)
       };
       resist(between(pair.s, pair.t, k, x) - between(pair.s, pair.t, k, start_), pair.push, x);
       resist(between(pair.s, pair.t, k, v), pair.stop, v);
+    }
+  return resolveFaces(model, state) || touched;
+}
+
+double SelfContacts::startSide(const NodeArray& now, int node, std::size_t face) const
+{
+  const std::array<int, 3>& f = faces_[face];
+  const auto side = [&](const NodeArray& y) {
+    return (y.col(f[1]) - y.col(f[0])).cross(y.col(f[2]) - y.col(f[0])).dot(y.col(node) - y.col(f[0]));
+  };
+  const double then = side(start_);
+  return std::copysign(1.0, then != 0.0 ? then : side(now));
+}
+
+bool SelfContacts::overFace(const NodeArray& x, int node, std::size_t face, double side, OverFace& over) const
+{
+  const std::array<int, 3>& f = faces_[face];
+  const TriangleCorners t{ x.col(f[0]), x.col(f[1]), x.col(f[2]) };
+  const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+  const double twice_area = n.norm();
+  if (!(twice_area > 0.0))
+    return false;  // a collapsed face: its edges are its neighbours'
+  over.weight = barycentric(x.col(node), t, n);
+  if (!(over.weight.minCoeff() >= 0.0))
+    return false;  // beside it: its edges' and corners' contacts
+  over.normal = side / twice_area * n;
+  over.height = over.normal.dot(x.col(node) - t[0]);
+  return true;
+}
+
+bool SelfContacts::resolveFaces(const Model& model, State& state)
+{
+  if (faces_.empty())
+    return false;
+  NodeArray& x = state.position;
+  NodeArray& v = state.velocity;
+  const Eigen::VectorXd& w = model.inverse_mass;
+  near_faces_.clear();
+  OverFace over;
+  for (const auto& [node, face] : face_candidates_)
+  {
+    const double side = startSide(x, static_cast<int>(node), face);
+    if (overFace(x, static_cast<int>(node), face, side, over) &&
+        over.height < model.contact_radius[static_cast<Eigen::Index>(node)] + face_radius_[face])
+      near_faces_.push_back({ static_cast<int>(node), face, side, 0.0, 0.0 });
+  }
+  // The node's and the corners' shares (as in resolve: each by its inverse mass and weight at the point),
+  // and a change of the gap between the node and the face's point applied to y.
+  const auto part = [&](const NearFace& pair, const OverFace& o, NodeArray& y, const Vec3& change) {
+    const std::array<int, 3>& f = faces_[pair.face];
+    double total = w[pair.node];
+    for (int k = 0; k < 3; ++k)
+      total += o.weight[k] * o.weight[k] * w[f[k]];
+    if (!(total > 0.0))
+      return;
+    const Vec3 unit = change / total;
+    y.col(pair.node) += w[pair.node] * unit;
+    for (int k = 0; k < 3; ++k)
+      y.col(f[k]) -= o.weight[k] * w[f[k]] * unit;
+  };
+  const auto gap = [&](const NearFace& pair, const OverFace& o, const NodeArray& y) {
+    const std::array<int, 3>& f = faces_[pair.face];
+    return Vec3(y.col(pair.node) - o.weight[0] * y.col(f[0]) - o.weight[1] * y.col(f[1]) - o.weight[2] * y.col(f[2]));
+  };
+  bool touched = false;
+  for (int pass = 0; pass < kPasses; ++pass)
+    for (NearFace& pair : near_faces_)
+    {
+      if (!overFace(x, pair.node, pair.face, pair.side, over))
+        continue;
+      const double reach = model.contact_radius[pair.node] + face_radius_[pair.face];
+      // No further back than the node and the face moved apart along the normal in the sub-step: a node
+      // behind the face by more than that was behind it at the start too.
+      const double moved = std::abs(over.normal.dot(gap(pair, over, x) - gap(pair, over, start_)));
+      const double push = std::max(-pair.push, std::min(reach - over.height, reach + moved));
+      const double stop = pair.push + push > 0.0 ? std::max(-pair.stop, -gap(pair, over, v).dot(over.normal)) : -pair.stop;
+      if (push != 0.0)
+        part(pair, over, x, push * over.normal);
+      if (stop != 0.0)
+        part(pair, over, v, stop * over.normal);
+      pair.push += push;
+      pair.stop += stop;
+      touched = touched || pair.push > 0.0;
+    }
+  if (!any_friction_ || !touched)
+    return touched;
+  // Coulomb friction as between links (resolve), with the mean of the two bodies' self_friction.
+  for (int pass = 0; pass < kPasses; ++pass)
+    for (NearFace& pair : near_faces_)
+    {
+      const double friction =
+          0.5 * (model.bodies[model.bodyOf(pair.node)].self_friction + face_friction_[pair.face]);
+      if (!(friction > 0.0) || !(pair.push > 0.0 || pair.stop > 0.0) ||
+          !overFace(x, pair.node, pair.face, pair.side, over))
+        continue;
+      const auto resist = [&](const Vec3& relative, double& budget, NodeArray& y) {
+        const Vec3 tangential = relative - relative.dot(over.normal) * over.normal;
+        const double length = tangential.norm();
+        if (!(length > 0.0))
+          return;
+        const double taken = std::min(length, friction * budget);
+        part(pair, over, y, -(taken / length) * tangential);
+        budget -= taken / friction;
+      };
+      resist(gap(pair, over, x) - gap(pair, over, start_), pair.push, x);
+      resist(gap(pair, over, v), pair.stop, v);
     }
   return touched;
 }

@@ -59,7 +59,8 @@ struct ClothDef
   /// Its nodes keep apart by their thickness from each other and from other self-colliding bodies
   /// (self_contacts.h): a folded cloth's layers stay apart. Needs 0.36 <= thickness / spacing < 0.5 (the
   /// spacing between neighbouring nodes): thinner, a node slips between four others; thicker, neighbours
-  /// overlap at rest.
+  /// overlap at rest. With face_contacts its triangles' edges and faces collide instead of its nodes as
+  /// balls, and any thickness below 0.5 spacing will do.
   bool self_collision = false;
   double self_friction = 0.0;  ///< Coulomb coefficient [-] between touching nodes, >= 0
   /// Its triangles (two per square) meet spheres, capsules, boxes and cylinders over their faces and

@@ -5,6 +5,7 @@
 // body asks has no pass here and pays nothing.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -72,7 +73,11 @@ void SegmentGrid::forEachNearPair(Visit visit) const
 
 /// Segment-against-segment contact of the bodies with `self_collision` (BodyRange); a body without links
 /// (a cloth, a jelly) gives each node as a segment from the node to itself, and one with springs_collide
-/// (a jelly) its springs as well, against which only its nodes collide.
+/// (a jelly) its springs as well, against which only its nodes collide. A cloth with `face_contacts` gives
+/// its triangles instead (Model::contact_triangles): their edges as segments of its thickness, and their
+/// faces, which every colliding node keeps out of (a node against a face, an edge against an edge: every
+/// way two such bodies come closest). A 5 mm rope then lies on a cloth of 5 cm spacing, which its nodes
+/// as balls would let it fall through.
 class SelfContacts
 {
 public:
@@ -80,15 +85,19 @@ public:
   SelfContacts(const Model& model, const NodeArray& rest);
 
   /// At the start of a sub-step (before anchors move): where the links start, from which friction
-  /// measures their slip. Nothing without friction.
+  /// measures their slip and a node tells the side of a face it came from. Nothing without friction or
+  /// faces.
   void remember(const State& state);
 
   /// After a sub-step's integration and colliders: every two links closer than their radii together
   /// (not neighbours along one rope, see kSkippedLinks) are pushed apart along the line between their
   /// nearest points, the correction shared by their four nodes in proportion to their inverse masses and
   /// weights there, their approach speed along that line removed, and Coulomb friction (the mean of the
-  /// two bodies' self_friction) acts on their slip past each other; kPasses times. True if any pair
-  /// touched.
+  /// two bodies' self_friction) acts on their slip past each other; kPasses times. A node over a face
+  /// closer than its radius and the face's thickness together is pushed out along the face's normal the
+  /// same way, to the side it was on at the sub-step's start (one that crossed the face within the
+  /// sub-step comes back), the correction shared by the node and the face's three by their weights. True
+  /// if any pair touched.
   bool resolve(const Model& model, State& state);
 
   /// How many times the candidate pairs have been searched: once per Verlet list (kSkinRadii).
@@ -114,11 +123,29 @@ private:
   /// The pairs within twice their radii and the skin, through the spatial hash.
   void findCandidates(const NodeArray& x);
 
+  /// The node-face pairs within the radii and the skin (nodes_ and faces_ through face_grid_).
+  void findFaceCandidates(const NodeArray& x);
+  /// A node's place over a face now: its weights there, the face's unit normal towards the side the node
+  /// started on, and the node's height over the face that way [m]; false if the node is not over it.
+  struct OverFace
+  {
+    Vec3 weight;
+    Vec3 normal;
+    double height;
+  };
+  bool overFace(const NodeArray& x, int node, std::size_t face, double side, OverFace& over) const;
+  /// The node's side of the face at the sub-step's start (+1 along its normal, -1 against it; `now`'s if
+  /// it lay in the face's plane then).
+  double startSide(const NodeArray& now, int node, std::size_t face) const;
+  /// The passes over the node-face pairs (see resolve); true if any touched.
+  bool resolveFaces(const Model& model, State& state);
+
   std::vector<std::pair<int, int>> segments_;  ///< global node pairs of the colliding links
   std::vector<int> body_;                      ///< per segment: its body
   std::vector<bool> springs_collide_;          ///< per body: BodyRange::springs_collide
+  std::vector<bool> by_faces_;                 ///< per body: collides by its contact triangles
   std::vector<double> radius_;                 ///< per segment: its nodes' mean contact radius [m]
-  NodeArray rest_;                             ///< per segment: its first node at rest [m]
+  NodeArray rest_;                             ///< every node at rest [m]
   std::vector<double> friction_;               ///< per segment: its body's self_friction [-]
   bool any_friction_ = false;
   NodeArray start_;                            ///< positions at the sub-step's start, if any friction [m]
@@ -139,6 +166,26 @@ private:
     double stop;         ///< [m/s] the approach speed they removed, likewise
   };
   std::vector<NearPair> near_;
+
+  std::vector<std::array<int, 3>> faces_;  ///< the contact triangles of the colliding cloths
+  std::vector<int> face_body_;             ///< per face: its body
+  std::vector<double> face_radius_;        ///< per face: its nodes' mean contact radius (thickness) [m]
+  std::vector<double> face_friction_;      ///< per face: its body's self_friction [-]
+  std::vector<double> node_radius_;        ///< per node of nodes_: its contact radius [m]
+  std::vector<int> node_body_;             ///< per node of nodes_: its body
+  std::vector<std::pair<int, int>> face_items_;  ///< face_grid_'s: each of nodes_ (n, n), then each face's first edge
+  SegmentGrid face_grid_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> face_candidates_;  ///< (node, face) that may touch
+  /// A node over a face this sub-step: the side it started on, and what the passes gave (as NearPair).
+  struct NearFace
+  {
+    int node;
+    std::uint32_t face;
+    double side;
+    double push;
+    double stop;
+  };
+  std::vector<NearFace> near_faces_;
 };
 
 }  // namespace soft_body_sim
