@@ -505,9 +505,16 @@ void BM_CoiledRopeFalling(benchmark::State& bench, bool self_collision)
 
 /// A 64 x 64 cloth, 1.26 m square (2 cm spacing, 8 mm thick), dropped from 0.2 m onto a sphere of 0.25 m
 /// on the floor, so that it drapes and folds onto itself; each step of its first second, again and again.
-/// With or without self-collision (its nodes as balls, self_contacts.h). xpbd at 1/60 s, 8 sub-steps: a
-/// fall of 0.7 m to the floor moves 7.7 mm per sub-step, within the thickness (tunnellingRisk).
-void BM_ClothOnSphere(benchmark::State& bench, bool self_collision)
+/// Without self-collision, with it by its nodes as balls (self_contacts.h), or by its triangles' edges
+/// and faces (face_contacts: its faces meet the sphere too). xpbd at 1/60 s, 8 sub-steps: a fall of 0.7 m
+/// to the floor moves 7.7 mm per sub-step, within the thickness (tunnellingRisk).
+enum class ClothCollision
+{
+  None,
+  Nodes,
+  Triangles,
+};
+void BM_ClothOnSphere(benchmark::State& bench, ClothCollision collision)
 {
   ClothDef cloth;
   cloth.nx = 64;
@@ -519,7 +526,8 @@ void BM_ClothOnSphere(benchmark::State& bench, bool self_collision)
   cloth.structural = { 1000.0, 0.05 };
   cloth.shear = { 500.0, 0.05 };
   cloth.thickness = 0.008;
-  cloth.self_collision = self_collision;
+  cloth.self_collision = collision != ClothCollision::None;
+  cloth.face_contacts = collision == ClothCollision::Triangles;
   SceneDef scene;
   scene.physics.integrator = IntegratorType::Xpbd;
   scene.physics.step = StepSettings{ 1.0 / 60.0, 8, 2 };
@@ -633,8 +641,9 @@ BENCHMARK_CAPTURE(BM_CoiledRopeFalling, self_collision, true)->Arg(1000)->Arg(10
 // Two whole drops each (the cost of a step changes as the cloth lands).
 BENCHMARK_CAPTURE(BM_ClothOnColliders, nodes_only, false)->Iterations(120)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ClothOnColliders, faces, true)->Iterations(120)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_ClothOnSphere, plain, false);
-BENCHMARK_CAPTURE(BM_ClothOnSphere, self_collision, true);
+BENCHMARK_CAPTURE(BM_ClothOnSphere, plain, ClothCollision::None);
+BENCHMARK_CAPTURE(BM_ClothOnSphere, self_collision, ClothCollision::Nodes);
+BENCHMARK_CAPTURE(BM_ClothOnSphere, triangles, ClothCollision::Triangles);
 BENCHMARK_CAPTURE(BM_SoftBox, cheaper, LinearSolve::Cheaper)->Arg(1700)->Arg(17000)->Arg(170000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SoftBox, direct, LinearSolve::Direct)->Arg(1700)->Arg(17000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SoftBox, iterative, LinearSolve::Iterative)->Arg(1700)->Arg(17000)->Arg(170000)->Unit(benchmark::kMillisecond);

@@ -202,25 +202,20 @@ void SelfContacts::findCandidates(const NodeArray& x)
     const auto [c, d] = segments_[t];
     if (a == c || a == d || b == c || b == d)
       return;
-    if (body_[s] == body_[t])
+    // Neighbours along one rope touch at their joints; a jelly's springs cross each other at rest (a cell's
+    // diagonals) and only its nodes stay out of them; a cloth's (or jelly's) nodes within twice their
+    // contact distance at rest (its direct and diagonal neighbours) are held apart by its springs, and come
+    // that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute Physics). A
+    // face-contact cloth's edges likewise: those within twice their contact distance at rest (below, once
+    // the pair is near: the test at rest is the dearer one).
+    const bool same_body = body_[s] == body_[t];
+    const bool by_faces = by_faces_[static_cast<std::size_t>(body_[s])];
+    if (same_body && !by_faces)
     {
-      // Neighbours along one rope touch at their joints; a jelly's springs cross each other at rest (a
-      // cell's diagonals) and only its nodes stay out of them; a cloth's (or jelly's) nodes within twice
-      // their contact distance at rest (its direct and diagonal neighbours) are held apart by its springs,
-      // and come that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute
-      // Physics).
-      // A face-contact cloth's edges likewise: those within twice their contact distance at rest.
       const bool ball_s = a == b, ball_t = c == d;
-      const std::size_t body = static_cast<std::size_t>(body_[s]);
-      double p, q;
-      if (by_faces_[body])
+      if (!ball_s && !ball_t)
       {
-        if (contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
-          return;
-      }
-      else if (!ball_s && !ball_t)
-      {
-        if (springs_collide_[body] || std::abs(a - c) <= kSkippedLinks)
+        if (springs_collide_[static_cast<std::size_t>(body_[s])] || std::abs(a - c) <= kSkippedLinks)
           return;
       }
       else if (ball_s && ball_t && (rest_.col(a) - rest_.col(c)).norm() < 2.0 * (radius_[s] + radius_[t]))
@@ -235,8 +230,11 @@ void SelfContacts::findCandidates(const NodeArray& x)
         bound * bound)
       return;
     double p, q;
-    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < within)
-      candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
+    if (!(contactGap(x, segments_[s], segments_[t], p, q).norm() < within))
+      return;
+    if (same_body && by_faces && contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
+      return;
+    candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
   });
   findFaceCandidates(x);
   found_at_ = x;
@@ -270,14 +268,19 @@ void SelfContacts::findFaceCandidates(const NodeArray& x)
     if (node == face[0] || node == face[1] || node == face[2])
       return;
     const double reach = node_radius_[s] + face_radius_[f];
+    // Bounding balls first (the face's about its first corner, of its two edges from there).
+    const Vec3 p = x.col(node), a = x.col(face[0]);
+    const double bound = std::max((x.col(face[1]) - a).norm(), (x.col(face[2]) - a).norm()) + reach + skin_;
+    if ((p - a).squaredNorm() > bound * bound)
+      return;
+    if (!((p - nearestOnTriangle(p, a, x.col(face[1]), x.col(face[2])).point).norm() < reach + skin_))
+      return;
     // A cloth's own node near the face at rest (a corner of the next triangle) is held off by its springs.
     if (node_body_[s] == face_body_[f] &&
         (rest_.col(node) - nearestOnTriangle(rest_.col(node), rest_.col(face[0]), rest_.col(face[1]), rest_.col(face[2])).point)
                 .norm() < 2.0 * reach)
       return;
-    const Vec3 p = x.col(node);
-    if ((p - nearestOnTriangle(p, x.col(face[0]), x.col(face[1]), x.col(face[2])).point).norm() < reach + skin_)
-      face_candidates_.emplace_back(static_cast<std::uint32_t>(node), static_cast<std::uint32_t>(f));
+    face_candidates_.emplace_back(static_cast<std::uint32_t>(node), static_cast<std::uint32_t>(f));
   });
 }
 
