@@ -340,8 +340,8 @@ INSTANTIATE_TEST_SUITE_P(Integrators, ClothOnARail,
 /// distance, `top` its highest point [m]), centred at y0: no point of any of its triangles ever inside the
 /// surface by more than a tenth of its thickness, during the fall and at rest.
 template <typename Distance>
-void expectNoTriangleInside(const std::string& integrator, int substeps, const Distance& distance, const std::string& yaml,
-                            double top, double y0)
+void expectNoTriangleInside(const std::string& integrator, int substeps, const Distance& distance,
+                            const std::string& yaml, double top, double y0)
 {
   World world = buildWorld(droppedCloth(integrator, substeps, yaml, top + 0.1, y0));
   double deepest = -1e300, deepest_at = 0.0;
@@ -375,7 +375,8 @@ TEST_P(ClothOnShapes, NoPointOfAnyTriangleGoesIntoABallOrABoxEdgeOrAMeshEdge)
   expectNoTriangleInside(GetParam().integrator, GetParam().substeps, sceneDistance(ball),
                          "  - {name: ball, shape: sphere, radius: 0.15, position: [0, 0, 0.5], friction: 0.5}\n",
                          0.65, 0.0);
-  const Vec3 size(1.2, 0.6, 0.4), centre(0.0, -0.3 + 0.0125, 0.5);  // its edge at y = 0.0125, a quarter spacing off a row
+  // Its edge at y = 0.0125, a quarter spacing off a row.
+  const Vec3 size(1.2, 0.6, 0.4), centre(0.0, -0.3 + 0.0125, 0.5);
   Box table{ {}, size };
   table.at.position = centre;
   expectNoTriangleInside(GetParam().integrator, GetParam().substeps, sceneDistance(table),

@@ -901,7 +901,8 @@ TEST_P(RopeOnATrampoline, AFiveMillimetreRopeStaysOnAClothOfFiveCentimetreSpacin
     const NodeArray& x = world.state().position;
     for (int k = 0; k + 1 < 61; ++k)
       for (const std::array<int, 3>& t : triangles)
-        crossings += crossesTriangle(x.col(rope + k), x.col(rope + k + 1), x.col(t[0]), x.col(t[1]), x.col(t[2])) ? 1 : 0;
+        if (crossesTriangle(x.col(rope + k), x.col(rope + k + 1), x.col(t[0]), x.col(t[1]), x.col(t[2])))
+          ++crossings;
   }
   EXPECT_EQ(crossings, 0);
   const NodeArray& x = world.state().position;

@@ -12,7 +12,8 @@ template <typename Shape>
 void addShapes(std::vector<std::unique_ptr<ColliderKind>>& kinds, const std::vector<Shape>& shapes, const Model& model)
 {
   if (!shapes.empty())
-    kinds.push_back(std::make_unique<ShapeContacts<Shape>>(shapes, model.nodeCount(), !model.contact_triangles.empty()));
+    kinds.push_back(
+        std::make_unique<ShapeContacts<Shape>>(shapes, model.nodeCount(), !model.contact_triangles.empty()));
 }
 }  // namespace
 

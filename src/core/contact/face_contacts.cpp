@@ -35,15 +35,15 @@ std::vector<ShapeFeature> shapeFeatures(const Mesh& mesh)
     {
       // The first triangle's outward normal, and the second's corner off the edge: below the first's plane
       // where the surface turns outward.
+      const auto vertex = [&](int v) { return m.vertices[static_cast<std::size_t>(v)]; };
       const Eigen::Vector3i& first = m.triangles[static_cast<std::size_t>(triangles[0])];
       const Eigen::Vector3i& second = m.triangles[static_cast<std::size_t>(triangles[1])];
-      const Vec3 normal = (m.vertices[static_cast<std::size_t>(first[1])] - m.vertices[static_cast<std::size_t>(first[0])])
-                              .cross(m.vertices[static_cast<std::size_t>(first[2])] - m.vertices[static_cast<std::size_t>(first[0])]);
+      const Vec3 normal = (vertex(first[1]) - vertex(first[0])).cross(vertex(first[2]) - vertex(first[0]));
       int off = second[0];
       for (int k = 0; k < 3; ++k)
         if (second[k] != a && second[k] != b)
           off = second[k];
-      const Vec3 out = m.vertices[static_cast<std::size_t>(off)] - va;
+      const Vec3 out = vertex(off) - va;
       outward = normal.dot(out) < -kFlat * normal.norm() * out.norm();
     }
     if (outward)

@@ -108,7 +108,8 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   {
     const std::size_t body = model.bodyOf(triangle[0]);
     const double radius =
-        (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] + model.contact_radius[triangle[2]]) / 3.0;
+        (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] + model.contact_radius[triangle[2]]) /
+        3.0;
     if (!model.bodies[body].self_collision || !(radius > 0.0))
       continue;
     has_links[body] = true;
@@ -232,7 +233,8 @@ void SelfContacts::findCandidates(const NodeArray& x)
     double p, q;
     if (!(contactGap(x, segments_[s], segments_[t], p, q).norm() < within))
       return;
-    if (same_body && by_faces && contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
+    if (same_body && by_faces &&
+        contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
       return;
     candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
   });
@@ -276,10 +278,13 @@ void SelfContacts::findFaceCandidates(const NodeArray& x)
     if (!((p - nearestOnTriangle(p, a, x.col(face[1]), x.col(face[2])).point).norm() < reach + skin_))
       return;
     // A cloth's own node near the face at rest (a corner of the next triangle) is held off by its springs.
-    if (node_body_[s] == face_body_[f] &&
-        (rest_.col(node) - nearestOnTriangle(rest_.col(node), rest_.col(face[0]), rest_.col(face[1]), rest_.col(face[2])).point)
-                .norm() < 2.0 * reach)
-      return;
+    if (node_body_[s] == face_body_[f])
+    {
+      const Vec3 at_rest = rest_.col(node);
+      if ((at_rest - nearestOnTriangle(at_rest, rest_.col(face[0]), rest_.col(face[1]), rest_.col(face[2])).point)
+              .norm() < 2.0 * reach)
+        return;
+    }
     face_candidates_.emplace_back(static_cast<std::uint32_t>(node), static_cast<std::uint32_t>(f));
   });
 }
@@ -462,7 +467,8 @@ bool SelfContacts::resolveFaces(const Model& model, State& state)
       // behind the face by more than that was behind it at the start too.
       const double moved = std::abs(over.normal.dot(gap(pair, over, x) - gap(pair, over, start_)));
       const double push = std::max(-pair.push, std::min(reach - over.height, reach + moved));
-      const double stop = pair.push + push > 0.0 ? std::max(-pair.stop, -gap(pair, over, v).dot(over.normal)) : -pair.stop;
+      const double stop =
+          pair.push + push > 0.0 ? std::max(-pair.stop, -gap(pair, over, v).dot(over.normal)) : -pair.stop;
       if (push != 0.0)
         part(pair, over, x, push * over.normal);
       if (stop != 0.0)

@@ -148,7 +148,7 @@ private:
   NodeArray rest_;                             ///< every node at rest [m]
   std::vector<double> friction_;               ///< per segment: its body's self_friction [-]
   bool any_friction_ = false;
-  NodeArray start_;                            ///< positions at the sub-step's start, if any friction [m]
+  NodeArray start_;                            ///< positions at the sub-step's start, if friction or faces [m]
   double largest_radius_ = 0.0;                ///< [m]
   std::vector<int> nodes_;                     ///< the nodes of the colliding links, each once
   double skin_ = 0.0;                          ///< [m]
@@ -173,7 +173,8 @@ private:
   std::vector<double> face_friction_;      ///< per face: its body's self_friction [-]
   std::vector<double> node_radius_;        ///< per node of nodes_: its contact radius [m]
   std::vector<int> node_body_;             ///< per node of nodes_: its body
-  std::vector<std::pair<int, int>> face_items_;  ///< face_grid_'s: each of nodes_ (n, n), then each face's first edge
+  /// face_grid_'s items: each of nodes_ as (n, n), then each face's first edge
+  std::vector<std::pair<int, int>> face_items_;
   SegmentGrid face_grid_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> face_candidates_;  ///< (node, face) that may touch
   /// A node over a face this sub-step: the side it started on, and what the passes gave (as NearPair).

@@ -13,10 +13,10 @@
 // slip off, was stretched over it again in every step (measured: a 21 x 21 cloth of 5 cm dropped on a 15 cm
 // ball at one sub-step of 1/60 s, its links 18 times their length within a second); held, it rests on it,
 // its links 8 % long. Its faces and edges meet the colliders in the contact stage.
-// A free node of a tetrahedron or a contact triangle is held when its predicted position x + offset lies, at the step's end (the
-// surface moved on by h v_s), inside a collider (ContactQuery) at a depth d > 0, or less than |g| h^2
-// outside it (d > -|g| h^2: resting on it) unless its hold pulled it at the end of the last step (it is
-// leaving). It is held on the surface along the normal n by a spring of stiffness k with
+// A free node of a tetrahedron or a contact triangle is held when its predicted position x + offset lies,
+// at the step's end (the surface moved on by h v_s), inside a collider (ContactQuery) at a depth d > 0, or
+// less than |g| h^2 outside it (d > -|g| h^2: resting on it) unless its hold pulled it at the end of the
+// last step (it is leaving). It is held on the surface along the normal n by a spring of stiffness k with
 // h^2 k = kContactStiffness times its diagonal block's mean eigenvalue b: the block gains h^2 k n n^T and
 // rhs h k d n, so that the solve leaves about 1 / kContactStiffness of d. Coulomb friction acts in the same
 // solve, as a damping of the velocity relative to the surface across n (frictionDamping), pressed by
