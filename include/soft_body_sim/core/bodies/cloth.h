@@ -63,10 +63,11 @@ struct ClothDef
   /// balls, and any thickness below 0.5 spacing will do.
   bool self_collision = false;
   double self_friction = 0.0;  ///< Coulomb coefficient [-] between touching nodes, >= 0
-  /// Its triangles (two per square) meet spheres, capsules, boxes and cylinders over their faces and
-  /// edges, not only at its nodes (face_contacts.h): a finger or rail thinner than the node spacing does
-  /// not pass between them. Off by default, experimental: at one sub-step of 1/60 s a 5 cm cloth dropped
-  /// onto a ball of 15 cm radius is thrown apart (at four it rests).
+  /// Its triangles (two per square) meet spheres, capsules, boxes, cylinders and meshes over their faces
+  /// and edges, not only at its nodes (face_contacts.h): a finger or rail thinner than the node spacing does
+  /// not pass between them. With self_collision they are also what other self-colliding bodies and the
+  /// cloth itself meet (self_contacts.h). Off by default, experimental: under xpbd at one sub-step of
+  /// 1/60 s a 5 cm cloth dropped onto a ball of 15 cm radius is torn (at four it rests).
   bool face_contacts = false;
 };
 
