@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <tuple>
 
 #include "core/contact/closest_points.h"
@@ -36,6 +37,20 @@ Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::
   const Vec3 along_from = x.col(from.second) - xa, along_to = x.col(to.second) - xc;
   std::tie(p, q) = closestSegmentParameters(xa, along_from, xc, along_to, kParallelSine2);
   return (xa + p * along_from) - (xc + q * along_to);
+}
+
+/// Coulomb friction at a contact of unit normal n: the change of `relative` (a motion, or a velocity, at
+/// the contact) that cancels its tangential part up to friction * budget, what it takes spent from budget;
+/// none if it has no tangential part.
+std::optional<Vec3> frictionChange(const Vec3& relative, const Vec3& n, double friction, double& budget)
+{
+  const Vec3 tangential = relative - relative.dot(n) * n;
+  const double length = tangential.norm();
+  if (!(length > 0.0))
+    return std::nullopt;
+  const double taken = std::min(length, friction * budget);
+  budget -= taken / friction;
+  return -(taken / length) * tangential;
 }
 
 /// A cell coordinate, kept far from the integer limits (a node at 1e300 m is a diverged one the guard
@@ -382,13 +397,8 @@ bool SelfContacts::resolve(const Model& model, State& state)
         continue;
       // Cancels the tangential part of `relative` (a motion of y at the contact) up to friction * budget.
       const auto resist = [&](const Vec3& relative, double& budget, NodeArray& y) {
-        const Vec3 tangential = relative - relative.dot(k.n) * k.n;
-        const double length = tangential.norm();
-        if (!(length > 0.0))
-          return;
-        const double taken = std::min(length, friction * budget);
-        part(pair.s, pair.t, k, y, -(taken / length) * tangential);
-        budget -= taken / friction;
+        if (const std::optional<Vec3> change = frictionChange(relative, k.n, friction, budget))
+          part(pair.s, pair.t, k, y, *change);
       };
       resist(between(pair.s, pair.t, k, x) - between(pair.s, pair.t, k, start_), pair.push, x);
       resist(between(pair.s, pair.t, k, v), pair.stop, v);
@@ -489,13 +499,8 @@ bool SelfContacts::resolveFaces(const Model& model, State& state)
           !overFace(x, pair.node, pair.face, pair.side, over))
         continue;
       const auto resist = [&](const Vec3& relative, double& budget, NodeArray& y) {
-        const Vec3 tangential = relative - relative.dot(over.normal) * over.normal;
-        const double length = tangential.norm();
-        if (!(length > 0.0))
-          return;
-        const double taken = std::min(length, friction * budget);
-        part(pair, over, y, -(taken / length) * tangential);
-        budget -= taken / friction;
+        if (const std::optional<Vec3> change = frictionChange(relative, over.normal, friction, budget))
+          part(pair, over, y, *change);
       };
       resist(gap(pair, over, x) - gap(pair, over, start_), pair.push, x);
       resist(gap(pair, over, v), pair.stop, v);
