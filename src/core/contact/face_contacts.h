@@ -181,6 +181,13 @@ struct FaceTouch
   Vec3 contact;
 };
 
+/// A contact triangle's thickness [m]: its nodes' mean contact radius.
+inline double triangleThickness(const Model& model, const std::array<int, 3>& triangle)
+{
+  return (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] + model.contact_radius[triangle[2]]) /
+         3.0;
+}
+
 /// The corners of a triangle [m].
 using TriangleCorners = std::array<Vec3, 3>;
 

@@ -122,9 +122,7 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   for (const std::array<int, 3>& triangle : model.contact_triangles)
   {
     const std::size_t body = model.bodyOf(triangle[0]);
-    const double radius =
-        (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] + model.contact_radius[triangle[2]]) /
-        3.0;
+    const double radius = triangleThickness(model, triangle);
     if (!model.bodies[body].self_collision || !(radius > 0.0))
       continue;
     has_links[body] = true;

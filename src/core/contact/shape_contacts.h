@@ -97,13 +97,6 @@ constexpr int kTrianglePasses = 4;
 /// into the shape.
 constexpr double kFaceSag = 0.5;
 
-/// A contact triangle's thickness [m]: its nodes' mean contact radius.
-inline double triangleThickness(const Model& model, const std::array<int, 3>& triangle)
-{
-  return (model.contact_radius[triangle[0]] + model.contact_radius[triangle[1]] + model.contact_radius[triangle[2]]) /
-         3.0;
-}
-
 /// A feature of a shape that touched a contact triangle (ShapeContacts' repeated sweeps).
 struct TouchedFeature
 {
