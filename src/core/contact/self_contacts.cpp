@@ -153,7 +153,8 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   }
   for (const BodyRange& body : model.bodies)
     springs_collide_.push_back(body.springs_collide);
-  rest_ = rest;
+  if (!segments_.empty())
+    rest_ = rest;  // a scene without self-collision keeps no copy
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
   for (const auto& [a, b] : segments_)

@@ -145,7 +145,7 @@ private:
   std::vector<bool> springs_collide_;          ///< per body: BodyRange::springs_collide
   std::vector<bool> by_faces_;                 ///< per body: collides by its contact triangles
   std::vector<double> radius_;                 ///< per segment: its nodes' mean contact radius [m]
-  NodeArray rest_;                             ///< every node at rest [m]
+  NodeArray rest_;                             ///< every node at rest [m], if any link collides
   std::vector<double> friction_;               ///< per segment: its body's self_friction [-]
   bool any_friction_ = false;
   NodeArray start_;                            ///< positions at the sub-step's start, if friction or faces [m]
