@@ -29,18 +29,6 @@ std::string figure(double value)
   return out.str();
 }
 
-/// Strain (l - L) / L of every spring whose stiffness is `stiffness` (a spring family of the cloth).
-std::vector<double> strains(const World& world, double stiffness)
-{
-  std::vector<double> out;
-  for (const Spring& s : world.model().springs)
-    if (s.stiffness == stiffness)
-      out.push_back((world.state().position.col(s.a) - world.state().position.col(s.b)).norm() / s.rest_length - 1.0);
-  return out;
-}
-
-double maxOf(const std::vector<double>& values) { return *std::max_element(values.begin(), values.end()); }
-
 // --- the builder ------------------------------------------------------------------------------------
 
 TEST(ClothBuilder, GridOfEqualMassesBetweenTheNamedCorners)

@@ -13,6 +13,7 @@
 #include "soft_body_sim/core/world.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "test_meshes.h"
+#include "test_util.h"
 
 namespace soft_body_sim
 {
@@ -336,16 +337,6 @@ INSTANTIATE_TEST_SUITE_P(Integrators, ClothOnARail,
                          ::testing::Values(FingerCase{ "xpbd", 4 }, FingerCase{ "implicit_euler", 1 }),
                          [](const ::testing::TestParamInfo<FingerCase>& info) { return info.param.integrator; });
 
-/// The most any spring of the world is stretched over its rest length [-].
-double longestSpring(const World& world)
-{
-  double longest = 0.0;
-  for (const Spring& spring : world.model().springs)
-    longest = std::max(longest, (world.state().position.col(spring.a) - world.state().position.col(spring.b)).norm() /
-                                    spring.rest_length);
-  return longest;
-}
-
 /// The cloth dropped from 10 cm onto a collider (declared by `yaml`; `distance`: its surface's signed
 /// distance, `top` its highest point [m]), centred at y0: no point of any of its triangles ever inside the
 /// surface by more than a tenth of its thickness, during the fall and at rest, and no spring torn.
@@ -364,7 +355,7 @@ void expectNoTriangleInside(const std::string& integrator, int substeps, const D
       deepest = inside;
       deepest_at = world.time();
     }
-    stretch = std::max(stretch, longestSpring(world));
+    stretch = std::max(stretch, 1.0 + test::maxOf(test::strains(world)));  // l / L of the longest spring
   }
   EXPECT_LT(deepest, 0.1 * 0.005) << "deepest at t = " << deepest_at << " s";
   ::testing::Test::RecordProperty("deepest_inside", std::to_string(deepest));

@@ -1,7 +1,9 @@
 // Helpers shared by the core tests: small scenes built from plain structs, and Eigen comparisons.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -12,6 +14,7 @@
 #include "soft_body_sim/core/bodies/volume.h"
 #include "soft_body_sim/core/elements/rods.h"
 #include "soft_body_sim/core/scene_def.h"
+#include "soft_body_sim/core/world.h"
 #include "soft_body_sim/core/stability.h"
 #include "soft_body_sim/core/elements/tetrahedra.h"
 
@@ -35,6 +38,20 @@ inline VolumeDef boxVolume(const Vec3& size, double resolution, const Vec3& cent
   box.density = density;
   return box;
 }
+
+/// Strain (l - L) / L of every spring of `world`, or of those whose stiffness is `stiffness` (a cloth's spring
+/// family).
+inline std::vector<double> strains(const World& world, std::optional<double> stiffness = std::nullopt)
+{
+  std::vector<double> out;
+  for (const Spring& s : world.model().springs)
+    if (!stiffness || s.stiffness == *stiffness)
+      out.push_back((world.state().position.col(s.a) - world.state().position.col(s.b)).norm() / s.rest_length - 1.0);
+  return out;
+}
+
+/// The largest of `values` (not empty).
+inline double maxOf(const std::vector<double>& values) { return *std::max_element(values.begin(), values.end()); }
 
 /// Asserts |a - b|_inf <= tol and prints both sides on failure.
 template <typename A, typename B>
