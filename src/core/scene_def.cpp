@@ -203,6 +203,12 @@ World buildWorld(const SceneDef& scene)
     for (std::array<int, 3>& triangle : surface)
       for (int& node : triangle)
         node = globalIndex(body, first, node);
+    for (SurfaceSample sample : body.surface_samples)
+    {
+      for (int& node : sample.triangle)
+        node = globalIndex(body, first, node);
+      model.surface_samples.push_back(sample);
+    }
     for (const auto& [a, b] : body.contact_segments)
       model.contact_segments.emplace_back(globalIndex(body, first, a), globalIndex(body, first, b));
     for (const std::array<int, 3>& triangle : body.contact_triangles)

@@ -133,6 +133,14 @@ struct BodyRange
   double surface_friction = 0.0;
 };
 
+/// A point of a solid's boundary triangle, at fixed barycentric weights of its three nodes (summing to 1),
+/// that meets the colliders besides the nodes themselves (VolumeDef::surface_samples; surface_holds.h).
+struct SurfaceSample
+{
+  std::array<int, 3> triangle;  ///< node indices, counter-clockwise seen from outside
+  Vec3 weight;                  ///< of triangle[0], [1], [2]
+};
+
 /// A named node of a body that the caller moves kinematically (its node is pinned).
 struct Anchor
 {
@@ -163,6 +171,9 @@ struct Model
   std::vector<PressureCell> cells;  ///< empty unless a scene has jelly: no pressure pass then
   std::vector<Rod> rods;            ///< empty unless a scene has rods: no bending or twist pass then
   std::vector<Tetrahedron> tetrahedra;  ///< empty unless a scene has volumes: no elasticity pass then
+  /// Points of solids' boundary triangles held on the colliders inside implicit_euler's solve, a
+  /// triangle's consecutive; empty unless a solid declares surface_samples: no pass then.
+  std::vector<SurfaceSample> surface_samples;
   std::vector<BodyRange> bodies;
   Colliders colliders;  ///< as the scene declares them; the contact stage prepares its own copies
   std::vector<Anchor> anchors;

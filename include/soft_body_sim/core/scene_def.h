@@ -108,6 +108,8 @@ struct BodyDef
   /// A solid's Coulomb coefficient [-] >= 0 against the other bodies' nodes on its surface
   /// (BodyRange::surface_friction; a volume's `friction`).
   double surface_friction = 0.0;
+  /// Model::surface_samples, in the body's node indices (a volume's surface_samples); empty: none.
+  std::vector<SurfaceSample> surface_samples;
 };
 
 /// The checks of a body's self-contact keys, for the builder of its type (rope, rod, cloth, jelly) or, for a

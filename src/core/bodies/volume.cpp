@@ -1,5 +1,6 @@
 #include "soft_body_sim/core/bodies/volume.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string>
@@ -87,6 +88,42 @@ void pinFace(const TetMesh& mesh, const Vec3& size, const BoxFace& face, BodyDef
     if (std::abs(mesh.nodes[k][face.axis] - plane) <= 1e-9 * size[face.axis])
       body.nodes[k].pinned = true;
 }
+
+/// The points of `mesh`'s boundary triangles at most `spacing` apart along the longest edge of each at rest:
+/// a triangle whose longest edge takes n spacings has the grid of barycentric weights (i, j, n - i - j) / n
+/// but its three corners (its nodes meet the colliders themselves). Refuses more than kMaxSurfaceSamples.
+std::vector<SurfaceSample> sampleSurface(const TetMesh& mesh, double spacing, const std::string& what)
+{
+  std::vector<int> divisions;
+  double count = 0.0;
+  for (const std::array<int, 3>& t : mesh.surface)
+  {
+    double longest = 0.0;
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, (mesh.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])] -
+                                   mesh.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>((k + 1) % 3)])])
+                                      .norm());
+    const double n = std::max(1.0, std::ceil(longest / spacing));
+    count += 0.5 * (n + 1.0) * (n + 2.0) - 3.0;
+    requireDefinition(count <= kMaxSurfaceSamples, what, { "surface_samples" },
+                      "surface_samples " + std::to_string(spacing) + " m lays more than " +
+                          std::to_string(static_cast<long long>(kMaxSurfaceSamples)) +
+                          " points on its surface: take a larger spacing (about the thinnest collider's radius)");
+    divisions.push_back(static_cast<int>(n));
+  }
+  std::vector<SurfaceSample> samples;
+  samples.reserve(static_cast<std::size_t>(count));
+  for (std::size_t t = 0; t < mesh.surface.size(); ++t)
+  {
+    const int n = divisions[t];
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j)
+        if (i != n && j != n && i + j != 0)
+          samples.push_back({ mesh.surface[t], Vec3(i, j, n - i - j) / static_cast<double>(n) });
+  }
+  return samples;
+}
+
 }  // namespace
 
 BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
@@ -106,6 +143,8 @@ BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
                     "friction must be >= 0 (a Coulomb coefficient)");
   requireDefinition(volume.pressure >= 0.0 && std::isfinite(volume.pressure), what, { "pressure" },
                     "pressure must be >= 0 [Pa] (the rest pressure of the gas each tetrahedron holds; 0: no gas)");
+  requireDefinition(volume.surface_samples >= 0.0 && std::isfinite(volume.surface_samples), what,
+                    { "surface_samples" }, "surface_samples must be >= 0 [m] (0: its nodes alone meet the colliders)");
   std::vector<const BoxFace*> faces;
   for (const std::string& face_name : volume.pinned_faces)
   {
@@ -149,6 +188,8 @@ BodyDef buildVolume(const std::string& name, const VolumeDef& volume)
     requireDefinition(node.mass > 0.0, what, { "mesh", "shape" },
                       "the mesh has a node in no tetrahedron (it would have no mass)");
   body.surface = mesh.surface;
+  if (volume.surface_samples > 0.0)
+    body.surface_samples = sampleSurface(mesh, volume.surface_samples, what);
 
   for (const BoxFace* face : faces)
     pinFace(mesh, *volume.size, *face, body);

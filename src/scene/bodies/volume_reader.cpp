@@ -39,7 +39,8 @@ void readPinnedNodesAndFaces(const Context& ctx, const Field& field, VolumeDef& 
 BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMap(ctx, field, withCommonBodyKeys({ "shape", "size", "radius", "mesh", "resolution", "position",
-                                              "youngs_modulus", "poisson_ratio", "density", "pinned", "friction", "pressure" }));
+                                              "youngs_modulus", "poisson_ratio", "density", "pinned", "friction", "pressure",
+                                              "surface_samples" }));
   VolumeDef volume;
   volume.shape = readVolumeShape(ctx, requiredKey(ctx, field, "shape"));
   readOptional(ctx, field, "size", volume.size, readVec3);
@@ -60,6 +61,7 @@ BodyDef readVolumeBody(const Context& ctx, const Field& field, const SceneSoFar&
     readPinnedNodesAndFaces(ctx, *value, volume);
   readOptional(ctx, field, "friction", volume.friction, readNumber);
   readOptional(ctx, field, "pressure", volume.pressure, readNumber);
+  readOptional(ctx, field, "surface_samples", volume.surface_samples, readNumber);
   volume.max_tetrahedra = scene.max_tetrahedra;
   BodyDef body = buildBody(ctx, field, volume, buildVolume);
   // The node count is known only after meshing; the mesher's own limit (max_tetrahedra) bounds the memory

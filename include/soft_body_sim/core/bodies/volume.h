@@ -21,6 +21,9 @@ enum class VolumeShape
   Mesh,    ///< `surface`: a closed triangle surface in its own frame, that frame's origin at `position`
 };
 
+/// The most surface samples a volume may have: a finer `surface_samples` is refused.
+constexpr double kMaxSurfaceSamples = 1.0e6;
+
 struct VolumeDef
 {
   VolumeShape shape = VolumeShape::Box;
@@ -42,6 +45,11 @@ struct VolumeDef
   double friction = 0.0;
   /// [Pa] the rest pressure p0 of the gas each tetrahedron holds (tetrahedra.h), >= 0; 0: no gas.
   double pressure = 0.0;
+  /// [m] >= 0: the spacing of the points of its boundary triangles that meet the colliders besides its
+  /// nodes (Model::surface_samples), held inside implicit_euler's solve: a rod or an edge thinner than the
+  /// tetrahedra presses the surface in where it touches, instead of slicing in between the nodes; about the
+  /// thinnest collider's radius. 0 (the default): its nodes alone meet the colliders.
+  double surface_samples = 0.0;
   /// The most tetrahedra its mesh may be asked for (volume_mesh.h): a finer resolution is refused.
   double max_tetrahedra = kMaxTetrahedra;
 };

@@ -98,7 +98,7 @@ public:
     }
     if (contacts_ != nullptr)
       collider_holds_.noteForces(model, h, delta_v_, *contacts_);
-    surface_holds_.noteForces(h, delta_v_);
+    surface_holds_.noteForces(h, delta_v_, contacts_);
     for (int i = 0; i < n; ++i)
       if (model.isFree(i))
         state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
@@ -147,7 +147,7 @@ private:
     forEachOf(kinds_, [&](auto& blocks) { blocks.assemble(point, system_); });
     if (contacts_ != nullptr)
       collider_holds_.assemble(point, *contacts_, first_iteration, system_);
-    surface_holds_.assemble(point, first_iteration, system_);
+    surface_holds_.assemble(point, first_iteration, system_, contacts_);
   }
 
   /// The blocks that the element kinds and the surface holds keep, as BlockSystem::solve asks for them.

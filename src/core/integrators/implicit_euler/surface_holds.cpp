@@ -1,6 +1,7 @@
 #include "core/integrators/implicit_euler/surface_holds.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/integrators/implicit_euler/hold_friction.h"
 
@@ -22,14 +23,95 @@ void SurfaceHolds::analyze(const Model& model, const BlockSystem& system)
   }
   element_pairs_ = system.pairCount();
   slot_of_pair_.clear();
+  // A solid's surface samples, a triangle's in a run: the runs, and a hold for each sample at most.
+  const std::vector<SurfaceSample>& samples = model.surface_samples;
+  sample_force_.assign(samples.size(), 0.0);
+  triangle_first_.clear();
+  for (std::size_t s = 0; s < samples.size(); ++s)
+    if (s == 0 || samples[s].triangle != samples[s - 1].triangle)
+      triangle_first_.push_back(s);
+  triangle_first_.push_back(samples.size());
+  holds_.reserve(holds_.capacity() + samples.size());
 }
 
-void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, BlockSystem& system)
+void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& colliders)
 {
-  if (!contacts_.has_value())
+  const Model& model = point.model;
+  const double h = point.h;
+  const double margin = model.gravity.norm() * h * h;
+  NodeContact contact;
+  for (std::size_t t = 0; t + 1 < triangle_first_.size(); ++t)
+  {
+    // Where the triangle starts the sub-step (x) and where its velocities take it (x + h v).
+    const std::array<int, 3>& triangle = model.surface_samples[triangle_first_[t]].triangle;
+    std::array<Vec3, 3> start, end;
+    double moved = 0.0;
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      start[k] = point.x.col(triangle[k]);
+      end[k] = start[k] + point.offset.col(triangle[k]);
+      moved = std::max(moved, (end[k] - start[k]).norm());
+    }
+    const Vec3 centre = (start[0] + start[1] + start[2]) / 3.0;
+    const double reach = std::sqrt(std::max(
+        { (start[0] - centre).squaredNorm(), (start[1] - centre).squaredNorm(), (start[2] - centre).squaredNorm() }));
+    if (!colliders.touching(model, triangle[0], centre, margin + moved + reach, contact))
+      continue;
+    // A point near a corner whose node is on the shape is left to that node's own hold (collider_holds.h):
+    // both would push the same part of the surface.
+    std::array<bool, 3> corner_held;
+    for (std::size_t k = 0; k < 3; ++k)
+    {
+      NodeContact at_corner;
+      corner_held[k] = colliders.touching(model, triangle[k], end[k], margin, at_corner);
+    }
+    for (std::size_t s = triangle_first_[t]; s < triangle_first_[t + 1]; ++s)
+    {
+      const Vec3& weight = model.surface_samples[s].weight;
+      if ((corner_held[0] && weight[0] >= kNearCorner) || (corner_held[1] && weight[1] >= kNearCorner) ||
+          (corner_held[2] && weight[2] >= kNearCorner))
+        continue;
+      // The shape's nearest point and normal from where the point starts the sub-step, so that the side it
+      // is pushed to is the side it came from (from x + h v, a point moving faster than the shape's radius
+      // per sub-step would be pushed out through the far side); the depth at x + h v along that normal,
+      // the shape moved on by its velocity there.
+      const Vec3 q = weight[0] * start[0] + weight[1] * start[1] + weight[2] * start[2];
+      const Vec3 predicted = weight[0] * end[0] + weight[1] * end[1] + weight[2] * end[2];
+      if (!colliders.touching(model, triangle[0], q, margin + (predicted - q).norm(), contact))
+        continue;
+      const double depth = contact.depth + (h * contact.velocity - (predicted - q)).dot(contact.normal);
+      // Held while it is in at x + h v, or, if it pushed in the last step, within |g| h^2 of that (a hold
+      // that comes and goes every other sub-step sets a surface chattering). Not with a node's margin
+      // (ColliderHolds) for every sample: the points of a flat face beside a round rod's line of contact
+      // would be pulled onto the rod.
+      if (!(depth > 0.0) && !(sample_force_[s] > 0.0 && depth > -margin))
+        continue;
+      // The collider takes the place of the surface hold's node p (weight 0, no node): the gap is -q.
+      Hold c;
+      c.touch = SurfaceTouch{ triangle[0], triangle, weight, -contact.normal, -predicted, depth, contact.friction };
+      c.nodes[0] = -1;
+      c.weights[0] = 0.0;
+      for (std::size_t l = 1; l < 4; ++l)
+      {
+        c.weights[l] = -weight[static_cast<Eigen::Index>(l - 1)];
+        c.nodes[l] = model.isFree(triangle[l - 1]) ? triangle[l - 1] : -1;
+      }
+      c.depth = c.scaled = 0.0;
+      c.block.setZero();
+      c.sample = static_cast<int>(s);
+      c.contact = contact;
+      holds_.push_back(c);
+    }
+  }
+}
+
+void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, BlockSystem& system,
+                            const ContactQuery* colliders)
+{
+  if (!present())
     return;
   if (first_iteration)
-    find(point);
+    find(point, colliders);
   const double h = point.h;
   const NodeArray& x = point.x;
   for (Hold& c : holds_)
@@ -43,7 +125,8 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
       gap += c.weights[l] * (x.col(all[l]) + point.offset.col(all[l]));
       relative += c.weights[l] * point.v.col(all[l]);
       if (c.nodes[l] >= 0)
-        inverse_block += c.weights[l] * c.weights[l] / (system.diagonal(c.nodes[l]).trace() / 3.0);
+        inverse_block += c.weights[l] * c.weights[l] /
+                         (c.sample >= 0 ? point.model.mass[c.nodes[l]] : system.diagonal(c.nodes[l]).trace() / 3.0);
     }
     c.depth = c.touch.depth - n.dot(gap - c.touch.gap);
     c.scaled = 0.0;
@@ -51,12 +134,20 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
     if (!(inverse_block > 0.0))
       continue;  // all four pinned
     const double block = 1.0 / inverse_block;  // b [kg]
-    c.scaled = kContactStiffness * block;
+    // A sample's: no stiffer than at sub-steps of kStiffestSampleStep.
+    const double shorter = h < kStiffestSampleStep ? (h * h) / (kStiffestSampleStep * kStiffestSampleStep) : 1.0;
+    c.scaled = (c.sample >= 0 ? kContactStiffness * shorter : kContactStiffness) * block;
     Vec3 push = (c.scaled / h * c.depth) * n;
     c.block = c.scaled * (n * n.transpose());
-    const double normal_force = std::max(block * c.depth / (h * h), hold_force_[static_cast<std::size_t>(c.touch.node)]);
+    if (c.sample >= 0)
+      relative += c.contact.velocity;
+    const double known = c.sample >= 0 ? sample_force_[static_cast<std::size_t>(c.sample)]
+                                       : hold_force_[static_cast<std::size_t>(c.touch.node)];
+    const double normal_force = std::max(block * c.depth / (h * h), known);
     Vec3 tangential;
     const double damping = frictionDamping(c.touch.friction, normal_force, relative, n, tangential);
+    c.damping = damping;
+    c.slip = tangential;
     if (damping > 0.0)
     {
       push -= h * damping * tangential;
@@ -68,13 +159,17 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
   }
 }
 
-void SurfaceHolds::find(const NewtonPoint& point)
+void SurfaceHolds::find(const NewtonPoint& point, const ContactQuery* colliders)
 {
   const Model& model = point.model;
   const double margin = model.gravity.norm() * point.h * point.h;
+  holds_.clear();
+  if (colliders != nullptr && !sample_force_.empty())
+    findSamples(point, *colliders);
+  if (!contacts_.has_value())
+    return;
   predicted_ = point.x + point.offset;
   contacts_->find(model, point.x, predicted_, std::max(margin, 0.5 * contacts_->widestRadius()), touches_);
-  holds_.clear();
   for (const SurfaceTouch& touch : touches_)
   {
     // A hold that pushed in the last step is kept while the node stays within half its radius (or |g| h^2)
@@ -163,19 +258,38 @@ double SurfaceHolds::force(const Hold& hold, double h, const NodeArray& dv)
 
 void SurfaceHolds::letGoPulling(double h, const NodeArray& dv)
 {
-  if (!contacts_.has_value())
+  if (!present())
     return;
   holds_.erase(std::remove_if(holds_.begin(), holds_.end(), [&](const Hold& c) { return force(c, h, dv) < 0.0; }),
                holds_.end());
 }
 
-void SurfaceHolds::noteForces(double h, const NodeArray& dv)
+void SurfaceHolds::noteForces(double h, const NodeArray& dv, ContactQuery* colliders)
 {
-  if (!contacts_.has_value())
+  if (!present())
     return;
   std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
+  std::fill(sample_force_.begin(), sample_force_.end(), 0.0);
   for (const Hold& c : holds_)
-    hold_force_[static_cast<std::size_t>(c.touch.node)] = force(c, h, dv);
+  {
+    const double normal_force = force(c, h, dv);
+    if (c.sample < 0)
+    {
+      hold_force_[static_cast<std::size_t>(c.touch.node)] = normal_force;
+      continue;
+    }
+    sample_force_[static_cast<std::size_t>(c.sample)] = normal_force;
+    if (colliders == nullptr)
+      continue;
+    // On the triangle's point: the push along the collider's normal and friction's pull towards its velocity.
+    Vec3 moved = Vec3::Zero();
+    for (int l = 1; l < 4; ++l)
+      if (c.nodes[l] >= 0)
+        moved += c.weights[l] * dv.col(c.nodes[l]);
+    const Vec3 n = c.touch.normal;
+    const Vec3 on_point = normal_force * c.contact.normal + c.damping * (c.slip + moved - n.dot(moved) * n);
+    colliders->receive(c.contact, -c.touch.gap - c.touch.depth * c.contact.normal, -h * on_point);
+  }
 }
 
 }  // namespace soft_body_sim

@@ -13,8 +13,18 @@
 // collider, pressed by max(b d / h^2, the hold's force in the last step), the solid's `friction` (two
 // solids': the mean). A hold couples a node to a triangle of another body: those node pairs join the
 // pattern when they first appear (placePairs).
+//
+// A solid's surface samples (Model::surface_samples) are held on the colliders in the same rows, the collider in p's
+// place (no node, weight 0): a point q of a boundary triangle at fixed weights that is in a shape at x + h v is pushed
+// out along the shape's normal, with friction relative to the shape's velocity at q, and the shape takes the opposite
+// impulse (its wrench). So a rod thinner than the tetrahedra presses the surface in between the nodes instead of
+// slicing into it. The normal and nearest point come from where q starts the sub-step (the side it is pushed to is the
+// side it came from), its depth from where it ends; it is held while it is in (or within |g| h^2 if it pushed in the
+// last step), and not near a corner whose node the collider holds itself (kNearCorner); its stiffness is
+// kStiffestSampleStep's. The triangle's three nodes share a tetrahedron: no new pattern pairs.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <unordered_map>
@@ -22,6 +32,7 @@
 
 #include "core/contact/surface_contacts.h"
 #include "core/integrators/implicit_euler/newton_system.h"
+#include "soft_body_sim/core/integrators/integrator.h"
 
 namespace soft_body_sim
 {
@@ -33,13 +44,14 @@ public:
   /// `system`: the holds' pairs come after them.
   void analyze(const Model& model, const BlockSystem& system);
   /// Whether the model can have surface holds at all.
-  bool present() const { return contacts_.has_value(); }
+  bool present() const { return contacts_.has_value() || !sample_force_.empty(); }
   /// Whether the Newton iteration being assembled has any.
   bool empty() const { return holds_.empty(); }
 
-  /// Finds the holds at the step's first Newton iteration and keeps them through the others; adds their
-  /// push and friction to rhs (their blocks stay here: multiply, addToPreconditioner, write).
-  void assemble(const NewtonPoint& point, bool first_iteration, BlockSystem& system);
+  /// Finds the holds at the step's first Newton iteration and keeps them through the others (the surface
+  /// samples' only with `colliders`); adds their push and friction to rhs (their blocks stay here:
+  /// multiply, addToPreconditioner, write).
+  void assemble(const NewtonPoint& point, bool first_iteration, BlockSystem& system, const ContactQuery* colliders);
   /// Gives every node pair of every hold (the node with the triangle's three, and those among themselves) a
   /// slot of the pattern. A pair not yet in it has the sparse pattern analysed again with it, the pairs of
   /// earlier holds kept unless they are more than kKeptPairs times the present holds' (then only these):
@@ -69,8 +81,8 @@ public:
 
   /// As ColliderHolds::letGoPulling.
   void letGoPulling(double h, const NodeArray& dv);
-  /// As ColliderHolds::noteForces.
-  void noteForces(double h, const NodeArray& dv);
+  /// As ColliderHolds::noteForces; the surface samples' impulses go to `colliders`.
+  void noteForces(double h, const NodeArray& dv, ContactQuery* colliders);
 
 private:
   struct Hold
@@ -81,12 +93,32 @@ private:
     double depth;        ///< d [m] at this iteration's predicted positions
     double scaled;       ///< h^2 k [kg] in this iteration
     Eigen::Matrix3d block;  ///< B = h^2 k n n^T + h c (I - n n^T); A gains weights_l weights_m B on (l, m)
+    /// Model::surface_samples' index of a sample held on a collider (then the collider is p: no node, weight
+    /// 0); -1: a node p on a solid's surface
+    int sample = -1;
+    /// the collider a sample touches (its normal points out of the collider)
+    NodeContact contact{ Vec3::Zero(), Vec3::Zero() };
+    double damping = 0.0;   ///< c [kg/s] of its friction in this iteration
+    Vec3 slip = Vec3::Zero();  ///< the relative velocity across n that friction damped, before the solve
   };
-  void find(const NewtonPoint& point);
+  void find(const NewtonPoint& point, const ContactQuery* colliders);
+  /// Holds every surface sample that is in a collider at x + h v (a triangle's points only where a collider
+  /// comes within the triangle's reach).
+  void findSamples(const NewtonPoint& point, const ContactQuery& colliders);
   /// k (d - h n . sum_l weights_l dv_l) [N]: the force `hold` took in the Newton iteration that solved dv
   /// (> 0 pushing).
   static double force(const Hold& hold, double h, const NodeArray& dv);
 
+  /// A sample this near a corner (its weight of that node at least this) is not held while the corner's
+  /// node is on the same collider.
+  static constexpr double kNearCorner = 0.7;
+  /// [s] A sample's hold has h^2 k = kContactStiffness b, b from the nodes' lumped masses (not from their
+  /// diagonal blocks, which count the collider holds already on them: next to a node on the shape, that
+  /// made a sample hundreds of times stiffer than the node's own hold, which threw a box off its rods), at
+  /// sub-steps h of this and longer; at shorter ones k stays at this one's. Holds stiffer than that on a
+  /// thin rod pressed into a soft box at 16 sub-steps of 1/60 s set its surface chattering at 10 m/s and let
+  /// the rod into the box; at 1/240 s and longer they leave it in by at most 0.3 mm (test_face_contacts).
+  static constexpr double kStiffestSampleStep = 1.0 / 240.0;
   /// How many times the present holds' node pairs the pattern keeps of earlier holds' (placePairs).
   static constexpr std::size_t kKeptPairs = 4;
 
@@ -99,6 +131,9 @@ private:
   std::size_t element_pairs_ = 0;            ///< how many of the pattern's pairs are the elements'
   std::unordered_map<std::uint64_t, std::size_t> slot_of_pair_;  ///< a hold's node pair -> its slot
   std::vector<int> slots_;                   ///< per hold, six: each node pair's slot, or -1
+  /// per sampled triangle, its first sample in Model::surface_samples (and one past the last)
+  std::vector<std::size_t> triangle_first_;
+  std::vector<double> sample_force_;         ///< per surface sample: [N] as hold_force_; empty: no samples
 };
 
 }  // namespace soft_body_sim
