@@ -27,6 +27,9 @@
 // BM_SoftStack/<touching|apart>: two 10 cm soft cubes (2.5 cm tetrahedra) on the floor at 1/60 s, one
 // resting on the other (its nodes held on the lower one's surface in the solve, about 100 holds) or beside
 // it: what the surface holds cost per step (World::step, settled for 2 s before timing).
+// BM_ThinRodPressing/<nodes|samples_2mm|samples_1mm>: config/scenes/soft_box.yaml's 8 cm box (1.6 cm
+// tetrahedra) on the floor with a 2 mm rod pressed 5 mm into its top, at 4 sub-steps of 1/60 s: what its
+// surface_samples cost per step against its nodes alone (which let the rod in).
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
 #include <cmath>
@@ -243,6 +246,38 @@ void BM_SoftBox(benchmark::State& bench, LinearSolve solve)
   bench.counters["tetrahedra"] = static_cast<double>(model.tetrahedra.size());
   bench.counters["nodes"] = model.nodeCount();
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.tetrahedra.size()));
+}
+
+void BM_ThinRodPressing(benchmark::State& bench, double spacing)
+{
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 4, 1 };
+  scene.physics.gravity = Vec3(0.0, 0.0, -9.81);
+  scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
+  VolumeDef box;
+  box.size = Vec3(0.08, 0.08, 0.08);
+  box.resolution = 0.016;
+  box.youngs_modulus = 5.0e4;
+  box.density = 200.0;
+  box.friction = 0.5;
+  box.position = Vec3(0.0, 0.0, 0.04);
+  box.surface_samples = spacing;
+  scene.bodies.push_back(buildVolume("box", box));
+  Capsule rod{ {}, 0.002, 0.3 };
+  rod.at.position = Vec3(0.0, 0.0, 0.08 + 0.002 - 0.005);
+  rod.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2.0, Vec3::UnitX()));
+  rod.at.friction = 0.5;
+  scene.colliders.capsules.push_back(rod);
+  World world = buildWorld(scene);
+  for (int step = 0; step < 30; ++step)
+    world.step();
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations());
 }
 
 void BM_SoftStack(benchmark::State& bench, bool touching)
@@ -650,6 +685,9 @@ BENCHMARK_CAPTURE(BM_SoftBox, iterative, LinearSolve::Iterative)->Arg(1700)->Arg
 BENCHMARK(BM_TetKernel);
 BENCHMARK_CAPTURE(BM_SoftStack, touching, true)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_SoftStack, apart, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ThinRodPressing, nodes, 0.0)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_2mm, 0.002)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_1mm, 0.001)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
 

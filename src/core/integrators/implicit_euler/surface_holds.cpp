@@ -65,6 +65,18 @@ void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& col
       NodeContact at_corner;
       corner_held[k] = colliders.touching(model, triangle[k], end[k], margin, at_corner);
     }
+    // Where the shape is flat under the whole triangle (a plane, a box's face: every corner nearest to the
+    // same shape along the same normal), a flat triangle's depth is greatest at a corner: its nodes meet it.
+    NodeContact flat;
+    bool flat_under = true;
+    for (std::size_t k = 0; k < 3 && flat_under; ++k)
+    {
+      NodeContact at_corner;
+      flat_under = colliders.touching(model, triangle[k], start[k], margin + moved + 2.0 * reach, at_corner) &&
+                   (k == 0 || (at_corner.collider == flat.collider && at_corner.normal.dot(flat.normal) > kSameNormal));
+      if (k == 0)
+        flat = at_corner;
+    }
     for (std::size_t s = triangle_first_[t]; s < triangle_first_[t + 1]; ++s)
     {
       const Vec3& weight = model.surface_samples[s].weight;
@@ -77,7 +89,8 @@ void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& col
       // the shape moved on by its velocity there.
       const Vec3 q = weight[0] * start[0] + weight[1] * start[1] + weight[2] * start[2];
       const Vec3 predicted = weight[0] * end[0] + weight[1] * end[1] + weight[2] * end[2];
-      if (!colliders.touching(model, triangle[0], q, margin + (predicted - q).norm(), contact))
+      if (!colliders.touching(model, triangle[0], q, margin + (predicted - q).norm(), contact) ||
+          (flat_under && contact.collider == flat.collider && contact.normal.dot(flat.normal) > kSameNormal))
         continue;
       const double depth = contact.depth + (h * contact.velocity - (predicted - q)).dot(contact.normal);
       // Held while it is in at x + h v, or, if it pushed in the last step, within |g| h^2 of that (a hold

@@ -112,6 +112,8 @@ private:
   /// A sample this near a corner (its weight of that node at least this) is not held while the corner's
   /// node is on the same collider.
   static constexpr double kNearCorner = 0.7;
+  /// Two contact normals whose dot product exceeds this are the same (a flat shape under a triangle).
+  static constexpr double kSameNormal = 1.0 - 1e-9;
   /// [s] A sample's hold has h^2 k = kContactStiffness b, b from the nodes' lumped masses (not from their
   /// diagonal blocks, which count the collider holds already on them: next to a node on the shape, that
   /// made a sample hundreds of times stiffer than the node's own hold, which threw a box off its rods), at
