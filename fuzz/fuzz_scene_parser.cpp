@@ -47,11 +47,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // iteration of each sub-step. A tetrahedron counts five: its 12x12 block, its SVD and the fill of a
   // solid's factorisation cost more. Measured under the sanitizers, five steps take 2-3 ms per tetrahedron
   // (2.0 s for soft_box.yaml's 937, 4.3 s for soft_stack.yaml's 1,560, 40 s for a 12,600-tetrahedron bar
-  // the fuzzer made, beyond its 25 s timeout): the largest solid that steps (2,000) stays near 6 s.
+  // the fuzzer made, beyond its 25 s timeout): the largest solid that steps (2,000) stays near 6 s. A
+  // solid's surface sample counts one (a distance to each collider near it per sub-step).
   std::size_t elements = 0;
   for (const BodyDef& body : scene.bodies)
     elements += body.nodes.size() + body.springs.size() + body.constraints.size() + body.cells.size() +
-                5 * body.tetrahedra.size();
+                5 * body.tetrahedra.size() + body.surface_samples.size();
   const double work =
       static_cast<double>(elements) * scene.physics.step.substeps * scene.physics.step.iterations;
   if (work > 1e4)
