@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "soft_body_sim/core/meshing/volume_mesh.h"
@@ -99,16 +100,20 @@ std::vector<SurfaceSample> sampleSurface(const TetMesh& mesh, double spacing, co
   for (const std::array<int, 3>& t : mesh.surface)
   {
     double longest = 0.0;
-    for (int k = 0; k < 3; ++k)
-      longest = std::max(longest, (mesh.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>(k)])] -
-                                   mesh.nodes[static_cast<std::size_t>(t[static_cast<std::size_t>((k + 1) % 3)])])
-                                      .norm());
+    for (std::size_t k = 0; k < 3; ++k)
+      longest = std::max(longest, (mesh.nodes[static_cast<std::size_t>(t[k])] -
+                                   mesh.nodes[static_cast<std::size_t>(t[(k + 1) % 3])]).norm());
     const double n = std::max(1.0, std::ceil(longest / spacing));
     count += 0.5 * (n + 1.0) * (n + 2.0) - 3.0;
-    requireDefinition(count <= kMaxSurfaceSamples, what, { "surface_samples" },
-                      "surface_samples " + std::to_string(spacing) + " m lays more than " +
-                          std::to_string(static_cast<long long>(kMaxSurfaceSamples)) +
-                          " points on its surface: take a larger spacing (about the thinnest collider's radius)");
+    if (!(count <= kMaxSurfaceSamples))
+    {
+      char message[200];
+      std::snprintf(message, sizeof message,
+                    "surface_samples %g m lays more than %.0f points on its surface: take a larger spacing (about "
+                    "the thinnest collider's radius)",
+                    spacing, kMaxSurfaceSamples);
+      requireDefinition(false, what, { "surface_samples" }, message);
+    }
     divisions.push_back(static_cast<int>(n));
   }
   std::vector<SurfaceSample> samples;
