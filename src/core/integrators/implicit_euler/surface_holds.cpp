@@ -57,6 +57,9 @@ void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& col
         { (start[0] - centre).squaredNorm(), (start[1] - centre).squaredNorm(), (start[2] - centre).squaredNorm() }));
     if (!colliders.touching(model, triangle[0], centre, margin + moved + reach, contact))
       continue;
+    // How far the shape moves in the sub-step (at the centre's velocity): a point that far outside at the
+    // start can be in at its end.
+    const double swept = h * contact.velocity.norm();
     // A point near a corner whose node is on the shape is left to that node's own hold (collider_holds.h):
     // both would push the same part of the surface.
     std::array<bool, 3> corner_held;
@@ -89,7 +92,7 @@ void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& col
       // the shape moved on by its velocity there.
       const Vec3 q = weight[0] * start[0] + weight[1] * start[1] + weight[2] * start[2];
       const Vec3 predicted = weight[0] * end[0] + weight[1] * end[1] + weight[2] * end[2];
-      if (!colliders.touching(model, triangle[0], q, margin + (predicted - q).norm(), contact) ||
+      if (!colliders.touching(model, triangle[0], q, margin + swept + (predicted - q).norm(), contact) ||
           (flat_under && contact.collider == flat.collider && contact.normal.dot(flat.normal) > kSameNormal))
         continue;
       const double depth = contact.depth + (h * contact.velocity - (predicted - q)).dot(contact.normal);
