@@ -248,6 +248,20 @@ void BM_SoftBox(benchmark::State& bench, LinearSolve solve)
   bench.SetItemsProcessed(bench.iterations() * static_cast<int64_t>(model.tetrahedra.size()));
 }
 
+/// Builds `scene`, steps it `settle` times untimed, then times its steps (an item each).
+void stepSettled(benchmark::State& bench, const SceneDef& scene, int settle)
+{
+  World world = buildWorld(scene);
+  for (int step = 0; step < settle; ++step)
+    world.step();
+  for (auto _ : bench)
+  {
+    world.step();
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+  bench.SetItemsProcessed(bench.iterations());
+}
+
 void BM_ThinRodPressing(benchmark::State& bench, double spacing)
 {
   SceneDef scene;
@@ -269,15 +283,7 @@ void BM_ThinRodPressing(benchmark::State& bench, double spacing)
   rod.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2.0, Vec3::UnitX()));
   rod.at.friction = 0.5;
   scene.colliders.capsules.push_back(rod);
-  World world = buildWorld(scene);
-  for (int step = 0; step < 30; ++step)
-    world.step();
-  for (auto _ : bench)
-  {
-    world.step();
-    benchmark::DoNotOptimize(world.state().position.data());
-  }
-  bench.SetItemsProcessed(bench.iterations());
+  stepSettled(bench, scene, 30);
 }
 
 void BM_SoftStack(benchmark::State& bench, bool touching)
@@ -298,15 +304,7 @@ void BM_SoftStack(benchmark::State& bench, bool touching)
   scene.bodies.push_back(buildVolume("lower", cube));
   cube.position = touching ? Vec3(0.0, 0.0, 0.151) : Vec3(0.3, 0.0, 0.05);
   scene.bodies.push_back(buildVolume("upper", cube));
-  World world = buildWorld(scene);
-  for (int step = 0; step < 120; ++step)
-    world.step();
-  for (auto _ : bench)
-  {
-    world.step();
-    benchmark::DoNotOptimize(world.state().position.data());
-  }
-  bench.SetItemsProcessed(bench.iterations());
+  stepSettled(bench, scene, 120);
 }
 
 void BM_TetKernel(benchmark::State& bench)

@@ -232,14 +232,14 @@ INSTANTIATE_TEST_SUITE_P(Integrators, FingerThroughCloth,
 
 // --- a cloth dropped onto shapes ----------------------------------------------------------------------
 
-/// How far inside a surface [m] the deepest of the cloth's triangle points lies (a grid of 66 per
-/// triangle, not only the nodes; < 0: the nearest point's distance outside it, negated), by the surface's
-/// signed distance `distance` in the scene frame.
+/// How far inside a surface [m] the deepest point of `triangles` lies (a grid of 66 per triangle, not only
+/// the nodes; < 0: the nearest point's distance outside it, negated), by the surface's signed distance
+/// `distance` in the scene frame.
 template <typename Distance>
-double deepestInside(const World& world, const Distance& distance)
+double deepestInside(const World& world, const std::vector<std::array<int, 3>>& triangles, const Distance& distance)
 {
   double deepest = -1e300;
-  for (const std::array<int, 3>& triangle : world.model().contact_triangles)
+  for (const std::array<int, 3>& triangle : triangles)
   {
     const TriangleCorners t{ world.state().position.col(triangle[0]), world.state().position.col(triangle[1]),
                              world.state().position.col(triangle[2]) };
@@ -308,7 +308,7 @@ TEST_P(ClothOnARail, AClothDroppedOnARailThinnerThanItsSpacingRestsDrapedOnIt)
   while (world.time() < 6.0)
   {
     world.step();
-    deepest = std::max(deepest, deepestInside(world, sceneDistance(rail)));
+    deepest = std::max(deepest, deepestInside(world, world.model().contact_triangles, sceneDistance(rail)));
   }
   EXPECT_LT(deepest, 0.1 * thickness) << "a triangle went into the rail";
   const NodeArray& x = world.state().position;
@@ -349,7 +349,7 @@ void expectNoTriangleInside(const std::string& integrator, int substeps, const D
   while (world.time() < 3.0)
   {
     world.step();
-    const double inside = deepestInside(world, distance);
+    const double inside = deepestInside(world, world.model().contact_triangles, distance);
     if (inside > deepest)
     {
       deepest = inside;
@@ -436,19 +436,6 @@ Vec3 forceOn(const World& world, const std::vector<std::string>& names)
   return force;
 }
 
-/// The deepest [m] any point of the solid's boundary triangles (a grid of 66 per triangle, not only the
-/// nodes or the samples) lies inside the surface of signed distance `distance`.
-template <typename Distance>
-double deepestOfSurface(const World& world, const Distance& distance)
-{
-  double deepest = -1e300;
-  const NodeArray& x = world.state().position;
-  for (const std::array<int, 3>& t : world.model().bodies.front().surface)
-    for (const Vec3& p : trianglePoints(TriangleCorners{ x.col(t[0]), x.col(t[1]), x.col(t[2]) }, 10))
-      deepest = std::max(deepest, -distance(p));
-  return deepest;
-}
-
 /// How far [m] a flat face may let a round shape of radius r in between samples s apart (the chord's sagitta
 /// over half the gap): r - sqrt(r^2 - (s / 2)^2).
 double gapBetweenSamples(double radius, double spacing)
@@ -500,7 +487,7 @@ TEST_P(SolidOnThinRods, ABoxOnTwoRodsThinnerThanItsTetrahedraRestsOnThemAndTheyC
   while (world.time() < 3.0)
   {
     world.step();
-    deepest = std::max(deepest, deepestOfSurface(world, distance));
+    deepest = std::max(deepest, deepestInside(world, world.model().bodies.front().surface, distance));
     if (world.time() > 2.0)
     {
       carried += forceOn(world, { "left", "right" });
@@ -570,7 +557,7 @@ TEST_P(ThinRodIntoSolid, AThinRodPressedIntoASoftBoxDentsItsSurfaceAndNeverEnter
       Capsule at{ {}, radius, 0.3 };
       at.at.position = Vec3(0.0, 0.0, start - speed * world.time());
       at.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2.0, Vec3::UnitX()));
-      deepest = std::max(deepest, deepestOfSurface(world, sceneDistance(at)));
+      deepest = std::max(deepest, deepestInside(world, world.model().bodies.front().surface, sceneDistance(at)));
       for (const double y : { -0.03, -0.015, 0.0, 0.015, 0.03 })
         axis_inside += crossingsAbove(world, y, at.at.position.z()) % 2;
     }
