@@ -263,7 +263,8 @@ inline std::optional<FaceTouch> faceTouch(const ShapeFeature& f, const ShapeFeat
     // The side at the start: of the same part of the feature, over the triangle where it was then.
     const double mid = 0.5 * (lo + hi);
     const Vec3 n_start = (t_start[1] - t_start[0]).cross(t_start[2] - t_start[0]);
-    const double h_start = n_start.dot(f_start.a + mid * (f_start.b - f_start.a) - t_start[0]);
+    const auto height_start = [&](double s) { return n_start.dot(f_start.a + s * (f_start.b - f_start.a) - t_start[0]); };
+    const double h_start = height_start(mid);
     const double side = h_start != 0.0 ? std::copysign(1.0, h_start) : std::copysign(1.0, h_lo + h_hi);
     const bool low = side * h_lo <= side * h_hi;
     const double height = side * (low ? h_lo : h_hi);
@@ -272,7 +273,11 @@ inline std::optional<FaceTouch> faceTouch(const ShapeFeature& f, const ShapeFeat
     const Vec3 on_face = p - (unit.dot(p - t[0])) * unit;
     const bool beside =
         f.flat_ends && !((f.b - f.a).dot(on_face - f.a) > 0.0 && (f.a - f.b).dot(on_face - f.b) > 0.0);
-    if (height < reach && !beside)
+    // A feature whose part crossed the triangle's plane at the start (a rail through a jelly's plane, met by
+    // the jelly's outline) came from no side of the face: its edges meet it.
+    const double start_lo = height_start(lo), start_hi = height_start(hi);
+    const bool crossing = (start_lo < 0.0 && start_hi > 0.0) || (start_lo > 0.0 && start_hi < 0.0);
+    if (height < reach && !beside && !crossing)
     {
       const Vec3 weight = barycentric(on_face, t, n);
       const double moved = relativeMotion(f, f_start, at, t, t_start, weight);

@@ -116,14 +116,15 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
     has_links[body] = true;
     add(a, b, body);
   }
-  // A cloth with face contacts: its triangles' edges, each once, and its faces.
+  // A cloth with face contacts: its triangles' edges, each once, and its faces. A jelly's (springs_collide)
+  // meet colliders only: it keeps apart by its nodes and springs.
   by_faces_.assign(model.bodies.size(), false);
   std::vector<std::pair<int, int>> edges;
   for (const std::array<int, 3>& triangle : model.contact_triangles)
   {
     const std::size_t body = model.bodyOf(triangle[0]);
     const double radius = triangleThickness(model, triangle);
-    if (!model.bodies[body].self_collision || !(radius > 0.0))
+    if (!model.bodies[body].self_collision || model.bodies[body].springs_collide || !(radius > 0.0))
       continue;
     has_links[body] = true;
     by_faces_[body] = true;

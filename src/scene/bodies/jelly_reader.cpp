@@ -8,7 +8,7 @@ BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& 
 {
   requireMap(ctx, field, withCommonBodyKeys({ "nx", "ny", "top_left", "top_right", "bottom_left", "mass", "edges",
                                               "diagonals", "pressure", "thickness", "self_collision",
-                                              "self_friction" }));
+                                              "self_friction", "face_contacts" }));
   JellyDef jelly;
   jelly.nx = readCount(ctx, requiredKey(ctx, field, "nx"), 1);
   const Field ny = requiredKey(ctx, field, "ny");
@@ -22,6 +22,7 @@ BodyDef readJellyBody(const Context& ctx, const Field& field, const SceneSoFar& 
   jelly.pressure = readNumber(ctx, requiredKey(ctx, field, "pressure"));
   readOptional(ctx, field, "thickness", jelly.thickness, readNumber);
   readSelfContact(ctx, field, jelly);
+  readOptional(ctx, field, "face_contacts", jelly.face_contacts, readBool);
   return buildBody(ctx, field, jelly, buildJelly);
 }
 

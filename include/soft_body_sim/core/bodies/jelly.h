@@ -43,6 +43,11 @@ struct JellyDef
   /// spring.
   bool self_collision = false;
   double self_friction = 0.0;                                ///< Coulomb coefficient [-] where it touches, >= 0
+  /// Its cells, two triangles each, meet spheres, capsules, boxes, cylinders and meshes over their faces and
+  /// edges, not only at its nodes (face_contacts.h, as a cloth's): a rail or finger thinner than a cell does
+  /// not pass between its nodes, across its plane or into its outline. Its self-collision stays by nodes and
+  /// springs. Off by default, experimental as a cloth's.
+  bool face_contacts = false;
 };
 
 /// The jelly as nodes, springs and pressure cells (type "jelly"). Each cell's corners run
