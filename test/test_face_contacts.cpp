@@ -140,6 +140,29 @@ TEST(FaceContactsKey, AClothHasTwoContactTrianglesPerSquareOnlyWhenItAsks)
   }
 }
 
+// A jelly's cells likewise: two triangles per cell, which tile its square (their areas sum to its area).
+TEST(FaceContactsKey, AJellyHasTwoContactTrianglesPerCellOnlyWhenItAsks)
+{
+  for (const bool faces : { false, true })
+  {
+    const World world = buildWorld(parseScene("bodies:\n"
+                                              "  - {name: jelly, type: jelly, nx: 3, ny: 2, mass: 0.1, pressure: 100,\n"
+                                              "     top_left: [0, 0, 1], top_right: [0.3, 0, 1], bottom_left: [0, 0, 0.8],\n"
+                                              "     edges: {stiffness: 100}, diagonals: {stiffness: 10},\n"
+                                              "     face_contacts: " + std::string(faces ? "true" : "false") + "}\n",
+                                              "key.yaml"));
+    const std::vector<std::array<int, 3>>& triangles = world.model().contact_triangles;
+    ASSERT_EQ(triangles.size(), faces ? 2u * 3u * 2u : 0u);
+    double area = 0.0;
+    for (const std::array<int, 3>& t : triangles)
+    {
+      const NodeArray& x = world.state().position;
+      area += 0.5 * (x.col(t[1]) - x.col(t[0])).cross(x.col(t[2]) - x.col(t[0])).norm();
+    }
+    EXPECT_NEAR(area, faces ? 0.3 * 0.2 : 0.0, 1e-12);
+  }
+}
+
 // --- a finger through a hanging cloth ------------------------------------------------------------------
 
 /// A 1 m cloth of 21 x 21 nodes (5 cm spacing, 5 mm thick) hanging in the x-z plane at y = 0 from its top
