@@ -12,9 +12,11 @@
 //
 // No tunnelling: a face contact is taken on the side of the triangle where the feature was at the start of
 // the sub-step, so a feature that crossed the face in one sub-step (a 1 cm finger moving 3.3 cm per step)
-// pushes the face back to its own far side, instead of out through the side it went to. That is a swept
-// test in its simplest form: it holds as long as the feature's crossing point stays over the face it
-// crossed within a sub-step, and ShapeContacts widens its search by the sub-step's motion to find it.
+// pushes the face back to its own far side, instead of out through the side it went to (a feature that lay
+// across the face's plane at the start, a rail through a jelly's plane, meets the triangle's edges only).
+// That is a swept test in its simplest form: it holds as long as the feature's crossing point stays over
+// the face it crossed within a sub-step, and ShapeContacts widens its search by the sub-step's motion to
+// find it.
 #pragma once
 
 #include <algorithm>
@@ -239,7 +241,9 @@ inline double relativeMotion(const ShapeFeature& f, const ShapeFeature& f_start,
 /// start), whose corners keep `thickness` [m] from the shape and whose face and edges `face_thickness`:
 /// where the triangle is closer to the feature's axis than that plus f.radius, the deepest of
 /// - over the face: the deepest point of the feature's part over the triangle, measured on the side the
-///   feature's part was on at the start (see the file's comment); the face moves along its normal;
+///   feature's part was on at the start (see the file's comment); the face moves along its normal. Not for
+///   a part that crossed the triangle's plane at the start (a rail through an upright jelly's plane): it
+///   came from neither side, and the edges below meet it;
 /// - beside it: the nearest points of the feature and each of the triangle's edges or corners, measured
 ///   along the direction from the one to the other at the start (so an edge or a node that slipped past
 ///   the feature within the sub-step comes back: a node's own contact with the shape's surface pushes it
