@@ -2,6 +2,7 @@
 // nearest distance of a triangle to each shape against sampling; a finger thinner than the node spacing
 // carries a hanging cloth between its nodes and never pierces it.
 #include <algorithm>
+#include <cmath>
 #include <optional>
 #include <random>
 #include <string>
@@ -206,7 +207,10 @@ class FingerThroughCloth : public ::testing::TestWithParam<FingerCase>
 // holds still for 2 s while the cloth settles round it. Truth: the finger's axis never crosses a triangle
 // (the cloth stays in front of it), the cloth ends beyond the finger (carried 0.3 m), and at rest no
 // point of any triangle (a grid of 66 per triangle, not only the nodes) is nearer the axis than the
-// finger's radius plus the part of the cloth's thickness its faces keep (kFaceSag).
+// finger's radius plus the part of the cloth's thickness its faces keep (kFaceSag). The contacts make no
+// energy: in the last half second no node beside the still finger (within 3 cm of its axis) moves as fast
+// as the finger did (measured: 0.8 m/s under xpbd, 0.7 under implicit_euler; 5 m/s there before the face
+// pushes' impulses were balanced, ShapeContacts::balanceFaceImpulses).
 TEST_P(FingerThroughCloth, AFingerThinnerThanTheSpacingCarriesTheClothBetweenTwoColumns)
 {
   World world = buildWorld(hangingClothAndFinger(GetParam().integrator, GetParam().substeps));
@@ -216,12 +220,15 @@ TEST_P(FingerThroughCloth, AFingerThinnerThanTheSpacingCarriesTheClothBetweenTwo
     return std::optional<RigidPose>(RigidPose{ Vec3(0.525, fingerY(t), 1.0), Eigen::Quaterniond::Identity() });
   }));
   const Model& model = world.model();
-  double nearest_at_rest = 1e300;
+  double nearest_at_rest = 1e300, fastest_beside = 0.0;
   while (world.time() < travel / speed + 2.0)
   {
     world.step();
     const Vec3 bottom(0.525, fingerY(world.time()), 0.3), top(0.525, fingerY(world.time()), 1.7);
     const bool resting = world.time() > travel / speed + 1.5;
+    for (int node = 0; resting && node < model.nodeCount(); ++node)
+      if (std::hypot(world.state().position(0, node) - bottom.x(), world.state().position(1, node) - bottom.y()) < 0.03)
+        fastest_beside = std::max(fastest_beside, world.state().velocity.col(node).norm());
     for (const std::array<int, 3>& triangle : model.contact_triangles)
     {
       const TriangleCorners t{ world.state().position.col(triangle[0]), world.state().position.col(triangle[1]),
@@ -243,6 +250,8 @@ TEST_P(FingerThroughCloth, AFingerThinnerThanTheSpacingCarriesTheClothBetweenTwo
     farthest = std::max(farthest, world.state().position(1, node));
   EXPECT_GT(farthest, 0.3) << "the finger went through the cloth";
   EXPECT_GT(nearest_at_rest, radius + kFaceSag * thickness - 1e-9);
+  EXPECT_LT(fastest_beside, speed);
+  RecordProperty("fastest_beside_at_rest", std::to_string(fastest_beside));
 }
 
 // implicit_euler's solve holds the cloth's nodes on the colliders but not yet its faces (they follow the
