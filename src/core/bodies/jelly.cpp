@@ -55,13 +55,9 @@ BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
       cell.normal = normal;
       cell.pressure = jelly.pressure;  // rest area: the initial one
       body.cells.push_back(cell);
-      // Two triangles per cell, split along the diagonal from (i, j) to (i + 1, j + 1), as a cloth's.
-      if (jelly.face_contacts)
-      {
-        body.contact_triangles.push_back({ node(i, j), node(i + 1, j), node(i + 1, j + 1) });
-        body.contact_triangles.push_back({ node(i, j), node(i + 1, j + 1), node(i, j + 1) });
-      }
     }
+  if (jelly.face_contacts)
+    addGridTriangles(body, columns, jelly.ny + 1);
   return body;
 }
 
