@@ -126,33 +126,15 @@ TEST(FaceGeometry, ATrianglesNearestDistanceToAMeshAgreesWithSampling)
                            Vec3(0.15, 0.1, 0.1));
 }
 
-// A cloth meets colliders with its triangles only when its scene asks (`face_contacts: true`): two per
-// square then, none by default.
-TEST(FaceContactsKey, AClothHasTwoContactTrianglesPerSquareOnlyWhenItAsks)
+/// A grid body (`body`: its YAML map, up to the key face_contacts) meets colliders with its triangles only
+/// when its scene asks (`face_contacts: true`): then 12, two per square of its 3 x 2, which tile its
+/// 0.3 m x 0.2 m (their areas sum to its area); none by default.
+void expectTwoTrianglesPerSquareOnlyWhenAsked(const std::string& body)
 {
   for (const bool faces : { false, true })
   {
-    const World world = buildWorld(parseScene("bodies:\n"
-                                              "  - {name: cloth, type: cloth, nx: 4, ny: 3, mass: 0.1,\n"
-                                              "     top_left: [0, 0, 1], top_right: [0.3, 0, 1], bottom_left: [0, 0.2, 1],\n"
-                                              "     structural: {stiffness: 100}, shear: {stiffness: 10},\n"
-                                              "     face_contacts: " + std::string(faces ? "true" : "false") + "}\n",
-                                              "key.yaml"));
-    EXPECT_EQ(world.model().contact_triangles.size(), faces ? 2u * 3u * 2u : 0u);
-  }
-}
-
-// A jelly's cells likewise: two triangles per cell, which tile its square (their areas sum to its area).
-TEST(FaceContactsKey, AJellyHasTwoContactTrianglesPerCellOnlyWhenItAsks)
-{
-  for (const bool faces : { false, true })
-  {
-    const World world = buildWorld(parseScene("bodies:\n"
-                                              "  - {name: jelly, type: jelly, nx: 3, ny: 2, mass: 0.1, pressure: 100,\n"
-                                              "     top_left: [0, 0, 1], top_right: [0.3, 0, 1], bottom_left: [0, 0, 0.8],\n"
-                                              "     edges: {stiffness: 100}, diagonals: {stiffness: 10},\n"
-                                              "     face_contacts: " + std::string(faces ? "true" : "false") + "}\n",
-                                              "key.yaml"));
+    const World world = buildWorld(
+        parseScene("bodies:\n  - {" + body + ", face_contacts: " + std::string(faces ? "true" : "false") + "}\n", "key.yaml"));
     const std::vector<std::array<int, 3>>& triangles = world.model().contact_triangles;
     ASSERT_EQ(triangles.size(), faces ? 2u * 3u * 2u : 0u);
     double area = 0.0;
@@ -163,6 +145,21 @@ TEST(FaceContactsKey, AJellyHasTwoContactTrianglesPerCellOnlyWhenItAsks)
     }
     EXPECT_NEAR(area, faces ? 0.3 * 0.2 : 0.0, 1e-12);
   }
+}
+
+TEST(FaceContactsKey, AClothHasTwoContactTrianglesPerSquareOnlyWhenItAsks)
+{
+  expectTwoTrianglesPerSquareOnlyWhenAsked("name: cloth, type: cloth, nx: 4, ny: 3, mass: 0.1,\n"
+                                           "     top_left: [0, 0, 1], top_right: [0.3, 0, 1], bottom_left: [0, 0.2, 1],\n"
+                                           "     structural: {stiffness: 100}, shear: {stiffness: 10}");
+}
+
+// A jelly's cells likewise: two triangles per cell.
+TEST(FaceContactsKey, AJellyHasTwoContactTrianglesPerCellOnlyWhenItAsks)
+{
+  expectTwoTrianglesPerSquareOnlyWhenAsked("name: jelly, type: jelly, nx: 3, ny: 2, mass: 0.1, pressure: 100,\n"
+                                           "     top_left: [0, 0, 1], top_right: [0.3, 0, 1], bottom_left: [0, 0, 0.8],\n"
+                                           "     edges: {stiffness: 100}, diagonals: {stiffness: 10}");
 }
 
 // --- a finger through a hanging cloth ------------------------------------------------------------------
