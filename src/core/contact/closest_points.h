@@ -1,5 +1,6 @@
-// The closest points of two segments: shared by a link's contact with a capsule (shape_contacts.h) and by
-// two links' contact with each other (self_contacts.cpp). Private to the core.
+// The closest points of two segments: shared by a link's contact with a capsule (shape_contacts.h), by
+// two links' contact with each other (self_contacts.cpp) and by two solids' edges (surface_contacts.cpp).
+// Private to the core.
 #pragma once
 
 #include <algorithm>
@@ -9,6 +10,15 @@
 
 namespace soft_body_sim
 {
+/// Two links within ~10 degrees of parallel (sin^2 of the angle between them below this) meet at the
+/// nearest of their ends to the other link (closestSegmentParameters; self_contacts.cpp, and two solids'
+/// edges in surface_contacts.cpp). A link lying along another (a rope in a groove, on a rope) then meets
+/// it at one of its nodes, each node pushed out by its own depth: a point inside the link (where the nearly
+/// parallel lines come closest, ill-conditioned) would push both nodes by the depth there, throwing out one
+/// that a neighbouring link had already freed, and that node, off the surface, would slip with no friction
+/// holding it.
+constexpr double kNearParallelSine2 = 0.03;
+
 /// The parameters s, t in [0, 1] of the nearest points p0 + s d1 and q0 + t d2 of two segments (Ericson,
 /// Real-Time Collision Detection, 5.1.9): s minimises the distance between the lines, clamped to the first
 /// segment; t is the second's parameter nearest to that point, and if it leaves [0, 1] it is clamped and s

@@ -14,16 +14,8 @@ namespace soft_body_sim
 {
 namespace
 {
-/// Two links within ~10 degrees of parallel (sin^2 of the angle between them below this) meet at the
-/// nearest of their ends to the other link (closestSegmentParameters). A link lying along another (a rope
-/// in a groove, on a rope) then meets it at one of its nodes, each node pushed out by its own depth: a
-/// point inside the link (where the nearly parallel lines come closest, ill-conditioned) would push both
-/// nodes by the depth there, throwing out one that a neighbouring link had already freed, and that node,
-/// off the surface, would slip with no friction holding it.
-constexpr double kParallelSine2 = 0.03;
-
 /// The vector [m] from the contact point of `to`'s segment to that of `from`'s (closestSegmentParameters,
-/// kParallelSine2), and their parameters p (along `from`) and q (along `to`).
+/// kNearParallelSine2), and their parameters p (along `from`) and q (along `to`).
 Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::pair<int, int>& to, double& p,
                 double& q)
 {
@@ -35,7 +27,7 @@ Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::
   }
   const Vec3 xa = x.col(from.first), xc = x.col(to.first);
   const Vec3 along_from = x.col(from.second) - xa, along_to = x.col(to.second) - xc;
-  std::tie(p, q) = closestSegmentParameters(xa, along_from, xc, along_to, kParallelSine2);
+  std::tie(p, q) = closestSegmentParameters(xa, along_from, xc, along_to, kNearParallelSine2);
   return (xa + p * along_from) - (xc + q * along_to);
 }
 

@@ -1,10 +1,25 @@
 #include "core/contact/surface_contacts.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <utility>
+
+#include "core/contact/closest_points.h"
 
 namespace soft_body_sim
 {
+namespace
+{
+/// The box (least, most) around an edge of nodes a and b, now (x) and predicted.
+std::pair<Vec3, Vec3> sweptBox(int a, int b, const NodeArray& x, const NodeArray& predicted)
+{
+  return { x.col(a).cwiseMin(x.col(b)).cwiseMin(predicted.col(a)).cwiseMin(predicted.col(b)),
+           x.col(a).cwiseMax(x.col(b)).cwiseMax(predicted.col(a)).cwiseMax(predicted.col(b)) };
+}
+}  // namespace
+
 TrianglePoint nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
 {
   // Ericson's walk over the Voronoi regions: a corner, an edge or the face.
@@ -51,30 +66,66 @@ SurfaceContacts::SurfaceContacts(const Model& model)
   for (std::size_t b = 0; b < model.bodies.size(); ++b)
     if (!model.bodies[b].surface.empty())
       solids_.push_back(b);
+  if (solids_.size() < 2)
+    return;  // no two solids: no edges meet
+  // Each solid's edges, each once, with the triangles on either side.
+  edges_first_.push_back(0);
+  std::vector<std::tuple<int, int, int>> sides;  // (lower node, higher node, triangle)
+  for (const std::size_t s : solids_)
+  {
+    const std::vector<std::array<int, 3>>& surface = model.bodies[s].surface;
+    sides.clear();
+    for (std::size_t t = 0; t < surface.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        sides.emplace_back(std::min(surface[t][k], surface[t][(k + 1) % 3]),
+                           std::max(surface[t][k], surface[t][(k + 1) % 3]), static_cast<int>(t));
+    std::sort(sides.begin(), sides.end());
+    for (std::size_t i = 0; i < sides.size();)
+    {
+      std::size_t j = i + 1;
+      while (j < sides.size() && std::get<0>(sides[j]) == std::get<0>(sides[i]) &&
+             std::get<1>(sides[j]) == std::get<1>(sides[i]))
+        ++j;
+      edges_.push_back({ std::get<0>(sides[i]), std::get<1>(sides[i]), std::get<2>(sides[i]),
+                         j > i + 1 ? std::get<2>(sides[i + 1]) : -1 });
+      i = j;
+    }
+    edges_first_.push_back(edges_.size());
+  }
 }
 
 void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
-                           std::vector<SurfaceTouch>& touches) const
+                           std::vector<SurfaceTouch>& touches)
 {
   touches.clear();
   const auto inside = [](const Vec3& at, const Vec3& low, const Vec3& high) {
     return (at.array() >= low.array()).all() && (at.array() <= high.array()).all();
   };
-  for (const std::size_t s : solids_)
+  // The box around each solid now and where it is predicted, widened by the widest radius and the margin.
+  low_.resize(solids_.size());
+  high_.resize(solids_.size());
+  for (std::size_t i = 0; i < solids_.size(); ++i)
   {
-    const BodyRange& solid = model.bodies[s];
-    // The box around the solid now and where it is predicted, widened by the widest radius and the margin.
-    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
-    Vec3 high = -low;
-    for (int i = solid.first; i < solid.first + solid.count; ++i)
+    const BodyRange& solid = model.bodies[solids_[i]];
+    low_[i] = Vec3::Constant(std::numeric_limits<double>::infinity());
+    high_[i] = -low_[i];
+    for (int p = solid.first; p < solid.first + solid.count; ++p)
     {
-      low = low.cwiseMin(x.col(i)).cwiseMin(predicted.col(i));
-      high = high.cwiseMax(x.col(i)).cwiseMax(predicted.col(i));
+      low_[i] = low_[i].cwiseMin(x.col(p)).cwiseMin(predicted.col(p));
+      high_[i] = high_[i].cwiseMax(x.col(p)).cwiseMax(predicted.col(p));
     }
-    if (!low.allFinite() || !high.allFinite())
+    low_[i].array() -= widest_ + margin;
+    high_[i].array() += widest_ + margin;
+  }
+  const auto finite = [&](std::size_t i) { return low_[i].allFinite() && high_[i].allFinite(); };
+  for (std::size_t i = 0; i < solids_.size(); ++i)
+  {
+    if (!finite(i))
       continue;  // the divergence guard's case
-    low.array() -= widest_ + margin;
-    high.array() += widest_ + margin;
+    const std::size_t s = solids_[i];
+    const BodyRange& solid = model.bodies[s];
+    const Vec3& low = low_[i];
+    const Vec3& high = high_[i];
     for (std::size_t other = 0; other < model.bodies.size(); ++other)
     {
       if (other == s)
@@ -116,10 +167,102 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
                                    on.weight[1] * predicted.col(t[1]) - on.weight[2] * predicted.col(t[2]);
         const double depth = model.contact_radius[p] - normal.dot(predicted_gap);
         if (depth > -margin)
-          touches.push_back({ p, t, on.weight, normal, predicted_gap, depth, friction });
+          touches.push_back({ { p, t[0], t[1], t[2] },
+                              { 1.0, -on.weight[0], -on.weight[1], -on.weight[2] },
+                              normal,
+                              predicted_gap,
+                              depth,
+                              friction });
       }
     }
   }
+  // Two solids' edges, those of each in the other's box.
+  for (std::size_t i = 0; i + 1 < edges_first_.size(); ++i)
+    for (std::size_t j = i + 1; j + 1 < edges_first_.size(); ++j)
+    {
+      if (!finite(i) || !finite(j))
+        continue;
+      edgesIn(i, x, predicted, low_[j], high_[j], near_first_);
+      if (near_first_.empty())
+        continue;
+      edgesIn(j, x, predicted, low_[i], high_[i], near_second_);
+      for (const std::size_t e : near_first_)
+        for (const std::size_t f : near_second_)
+          touchEdges(model, x, predicted, margin, e, f, solids_[i], solids_[j], touches);
+    }
+}
+
+void SurfaceContacts::edgesIn(std::size_t solid, const NodeArray& x, const NodeArray& predicted, const Vec3& low,
+                              const Vec3& high, std::vector<std::size_t>& found) const
+{
+  found.clear();
+  for (std::size_t e = edges_first_[solid]; e < edges_first_[solid + 1]; ++e)
+  {
+    const auto [least, most] = sweptBox(edges_[e].a, edges_[e].b, x, predicted);
+    if ((most.array() >= low.array()).all() && (least.array() <= high.array()).all())
+      found.push_back(e);
+  }
+}
+
+void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
+                                 std::size_t e, std::size_t f, std::size_t first, std::size_t second,
+                                 std::vector<SurfaceTouch>& touches) const
+{
+  const Edge& one = edges_[e];
+  const Edge& two = edges_[f];
+  const double radius = 0.25 * (model.contact_radius[one.a] + model.contact_radius[one.b] +
+                                model.contact_radius[two.a] + model.contact_radius[two.b]);
+  const Vec3 a = x.col(one.a), along_one = x.col(one.b) - a;
+  const Vec3 c = x.col(two.a), along_two = x.col(two.b) - c;
+  const double deepest = kDeepestCrossing * std::sqrt(std::min(along_one.squaredNorm(), along_two.squaredNorm()));
+  // Their boxes, now and predicted, within the radius, the margin and the deepest crossing of each other.
+  const double reach = radius + margin + deepest;
+  const auto [least_one, most_one] = sweptBox(one.a, one.b, x, predicted);
+  const auto [least_two, most_two] = sweptBox(two.a, two.b, x, predicted);
+  if (!((most_one.array() + reach >= least_two.array()).all() && (most_two.array() + reach >= least_one.array()).all()))
+    return;
+  const auto [s, t] = closestSegmentParameters(a, along_one, c, along_two, kNearParallelSine2);
+  if (!(s > kEdgeEnd && s < 1.0 - kEdgeEnd && t > kEdgeEnd && t < 1.0 - kEdgeEnd))
+    return;  // nearest at an end, or near parallel: that node and the other's faces
+  const Vec3 across = along_one.cross(along_two);
+  if (!(across.squaredNorm() > kNearParallelSine2 * along_one.squaredNorm() * along_two.squaredNorm()))
+    return;
+  // Each edge's outward direction (its triangles' normals summed); both must be folds.
+  bool folds = true;
+  const auto outward = [&](const Edge& edge, std::size_t body) {
+    const std::vector<std::array<int, 3>>& surface = model.bodies[body].surface;
+    const auto normal = [&](int triangle) {
+      const std::array<int, 3>& k = surface[static_cast<std::size_t>(triangle)];
+      return Vec3((x.col(k[1]) - x.col(k[0])).cross(x.col(k[2]) - x.col(k[0])).normalized());
+    };
+    const Vec3 left = normal(edge.left);
+    if (edge.right < 0)
+      return left;  // an open surface's rim
+    const Vec3 right = normal(edge.right);
+    folds = folds && left.dot(right) < std::cos(kFold);
+    return Vec3(left + right);
+  };
+  const Vec3 out_one = outward(one, first), out_two = outward(two, second);
+  if (!folds)
+    return;  // an edge inside a flat face: the other's nodes meet that face
+  Vec3 normal = across.normalized();
+  if (normal.dot(out_two - out_one) < 0.0)
+    normal = -normal;
+  if (!(normal.dot(out_two) > 0.0 && normal.dot(out_one) < 0.0))
+    return;  // not out of the second solid and into the first: no side to hold them on
+  const Vec3 gap = a + s * along_one - c - t * along_two;
+  if (normal.dot(gap) < -deepest)
+    return;  // crossed too far to be these edges' contact
+  const std::array<double, 4> weights{ 1.0 - s, s, -(1.0 - t), -t };
+  const std::array<int, 4> nodes{ one.a, one.b, two.a, two.b };
+  Vec3 predicted_gap = Vec3::Zero();
+  for (std::size_t l = 0; l < 4; ++l)
+    predicted_gap += weights[l] * predicted.col(nodes[l]);
+  const double depth = radius - normal.dot(predicted_gap);
+  if (depth > -margin)
+    touches.push_back({ nodes, weights, normal, predicted_gap, depth,
+                        0.5 * (model.bodies[first].surface_friction + model.bodies[second].surface_friction),
+                        static_cast<std::int64_t>(e * edges_.size() + f) });
 }
 
 }  // namespace soft_body_sim

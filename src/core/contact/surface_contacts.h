@@ -1,12 +1,14 @@
 // Where other bodies touch a soft solid's surface (`type: volume`): every node of another body (a rope's,
 // a cloth's, another solid's) that is within its contact radius of a solid's boundary triangles, or behind
-// them. implicit_euler holds each such node on the surface inside its Newton solve, coupled to the
-// triangle's three nodes (see its surface holds). A scene with no solid, or with a solid and no other body,
-// has no finder and pays nothing.
+// them; and where two solids meet, every edge of one's boundary near or across an edge of the other's.
+// implicit_euler holds each such pair apart inside its Newton solve (see its surface holds). A scene with no
+// solid, or with a solid and no other body, has no finder and pays nothing.
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
@@ -23,18 +25,26 @@ struct TrianglePoint
 };
 TrianglePoint nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
 
-/// A node p of one body near or behind a boundary triangle of a solid: the weights of the triangle's point q
-/// nearest to p, q = sum_k weight_k x_(triangle_k), the direction n along which p is held out of the solid,
-/// and its depth d = r_p - n . (x_p - q) (> 0: closer than its contact radius, or behind); see find.
+/// Two bodies touching at a solid's surface (see SurfaceContacts::find), as the gap g = sum_l weights_l
+/// x_(nodes_l) between the two points that touch:
+/// - a node p of one body near or behind a boundary triangle of a solid: nodes (p, the triangle's three),
+///   weights (1, -w_0, -w_1, -w_2), so g = x_p - q with q the triangle's point nearest to p at weights w;
+/// - an edge (a, b) of one solid's boundary near or across an edge (c, d) of another's: nodes (a, b, c, d),
+///   weights (1 - s, s, -(1 - t), -t), so g is the first edge's point minus the second's, s and t where the
+///   edges come closest.
+/// n is the direction along which the first point is held out (from the triangle, or from the second
+/// edge), d = r - n . g its depth (> 0: closer than r, or behind), r the node's contact radius or the
+/// edges' nodes' mean.
 struct SurfaceTouch
 {
-  int node;
-  std::array<int, 3> triangle;
-  Vec3 weight;
+  std::array<int, 4> nodes;
+  std::array<double, 4> weights;
   Vec3 normal;
-  Vec3 gap;  ///< x_p - q [m] at the predicted positions
+  Vec3 gap;  ///< g [m] at the predicted positions
   double depth;
   double friction;  ///< Coulomb coefficient: the solid's `friction`, the mean of two solids'
+  /// -1 for a node on a triangle (nodes[0] is the node); for two edges, a number no other pair of edges has
+  std::int64_t edges = -1;
 };
 
 class SurfaceContacts
@@ -48,26 +58,70 @@ public:
   /// The largest contact radius of any node [m] (radii are fixed when the world is built).
   double widestRadius() const { return widest_; }
 
-  /// Every node p of a body other than the solid's that is near or behind a solid's boundary triangle, into
-  /// `touches` (cleared first). The triangle is the nearest to p at the positions x (the start of the step),
-  /// and so are the weights and n: the triangle's outward normal where p is behind its plane, else the
-  /// direction from q to p rounded towards that normal by kRounding of the triangle's size (the normal of
-  /// the face where q lies inside it; off an edge or a corner it turns with p, and where p sits on a corner
-  /// of a flat face it is the face's normal, not a direction that flips with p's smallest offsets). The
-  /// depth is at the `predicted` positions (x + h v): d = r_p - n . (p - q), and p is kept when d > -margin.
-  /// Taking the triangle where p is, not where it is predicted, holds a node that approaches a face fast on
-  /// that face (predicted past it, it may lie nearer another). Nodes outside the solid's bounding box now
-  /// and predicted, widened by the largest contact radius and the margin, are skipped without looking at a
-  /// triangle.
+  /// Every node p of a body other than the solid's that is near or behind a solid's boundary triangle, and
+  /// every pair of edges of two solids' boundaries that are near or across each other, into `touches`
+  /// (cleared first).
+  ///
+  /// A node's triangle is the nearest to p at the positions x (the start of the step), and so are the
+  /// weights and n: the triangle's outward normal where p is behind its plane, else the direction from q to
+  /// p rounded towards that normal by kRounding of the triangle's size (the normal of the face where q lies
+  /// inside it; off an edge or a corner it turns with p, and where p sits on a corner of a flat face it is
+  /// the face's normal, not a direction that flips with p's smallest offsets). Taking the triangle where p
+  /// is, not where it is predicted, holds a node that approaches a face fast on that face (predicted past
+  /// it, it may lie nearer another).
+  ///
+  /// Two edges touch where they come closest at x inside both (at an end, that end's node meets the other
+  /// solid's faces), both are folds of their surfaces (their two triangles turn by more than kFold: two
+  /// rims crossing, where neither has a node on the other's face), and they are not within ~10 degrees of
+  /// parallel (then the nodes meet the faces). An edge inside a flat face is left to the other solid's
+  /// nodes on that face: a rim's contact with it, tried, set the rim's nodes chattering at 0.1 m/s where
+  /// two turned cubes rest on each other (friction's share of it: 1 mm/s without). n is across both edges,
+  /// pointing out of the second solid at its edge and into the first at its own (the sum of each edge's two
+  /// triangle normals says which way is out): so two edges that have crossed are pushed back the way they
+  /// came. Pairs crossed by more than kDeepestCrossing of the shorter edge are left (no longer a contact of
+  /// those edges).
+  ///
+  /// The depth is at the `predicted` positions (x + h v), d = r - n . g, and a pair is kept when
+  /// d > -margin. Nodes and edges outside the other solid's bounding box now and predicted, widened by the
+  /// largest contact radius and the margin, are skipped without looking at a triangle or an edge.
   void find(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
-            std::vector<SurfaceTouch>& touches) const;
+            std::vector<SurfaceTouch>& touches);
 
   /// The rounding of edges and corners, relative to the square root of twice a triangle's area.
   static constexpr double kRounding = 0.1;
 
+  /// Two edges whose nearest points lie within this fraction of an end of either do not touch: that end's
+  /// node meets the other solid's faces (and where two solids' rims meet at their corners, a touch that
+  /// came and went with the smallest motion would set them chattering).
+  static constexpr double kEdgeEnd = 0.05;
+  /// Two edges crossed by more than this fraction of the shorter one's length do not touch.
+  static constexpr double kDeepestCrossing = 0.25;
+  /// An edge is a fold where its two triangles' normals differ by more than this angle [rad] (an open
+  /// surface's rim is one too).
+  static constexpr double kFold = 30.0 * M_PI / 180.0;
+
 private:
+  /// A boundary edge of a solid: its nodes, the surface's triangles on either side (Model::bodies' surface
+  /// indices; the second -1 on an open surface's rim).
+  struct Edge
+  {
+    int a, b;
+    int left, right;
+  };
+  /// The edges of `solid`'s boundary in `edges_` that lie in the box [low, high] now or predicted.
+  void edgesIn(std::size_t solid, const NodeArray& x, const NodeArray& predicted, const Vec3& low, const Vec3& high,
+               std::vector<std::size_t>& found) const;
+  /// Edges e and f of two solids (indices into edges_; Model::bodies `first` and `second`) into `touches` if
+  /// they touch (find).
+  void touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t e,
+                  std::size_t f, std::size_t first, std::size_t second, std::vector<SurfaceTouch>& touches) const;
+
   double widest_;                    ///< widestRadius()
   std::vector<std::size_t> solids_;  ///< bodies with a surface (Model::bodies), when another body exists
+  std::vector<Edge> edges_;          ///< every solid's boundary edges, each once, a solid's in a run
+  std::vector<std::size_t> edges_first_;  ///< per entry of solids_, its first edge in edges_ (and one past the last)
+  std::vector<Vec3> low_, high_;     ///< find's boxes around the solids (per entry of solids_)
+  std::vector<std::size_t> near_first_, near_second_;  ///< find's edges in the other solid's box
 };
 
 }  // namespace soft_body_sim

@@ -104,14 +104,15 @@ void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& col
         continue;
       // The collider takes the place of the surface hold's node p (weight 0, no node): the gap is -q.
       Hold c;
-      c.touch = SurfaceTouch{ triangle[0], triangle, weight, -contact.normal, -predicted, depth, contact.friction };
+      c.touch = SurfaceTouch{ { triangle[0], triangle[0], triangle[1], triangle[2] },
+                              { 0.0, -weight[0], -weight[1], -weight[2] },
+                              -contact.normal,
+                              -predicted,
+                              depth,
+                              contact.friction };
       c.nodes[0] = -1;
-      c.weights[0] = 0.0;
       for (std::size_t l = 1; l < 4; ++l)
-      {
-        c.weights[l] = -weight[static_cast<Eigen::Index>(l - 1)];
-        c.nodes[l] = model.isFree(triangle[l - 1]) ? triangle[l - 1] : -1;
-      }
+        c.nodes[l] = model.isFree(c.touch.nodes[l]) ? c.touch.nodes[l] : -1;
       c.depth = c.scaled = 0.0;
       c.block.setZero();
       c.sample = static_cast<int>(s);
@@ -135,13 +136,14 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
     const Vec3& n = c.touch.normal;
     Vec3 gap = Vec3::Zero(), relative = Vec3::Zero();
     double inverse_block = 0.0;
-    const int all[4] = { c.touch.node, c.touch.triangle[0], c.touch.triangle[1], c.touch.triangle[2] };
-    for (int l = 0; l < 4; ++l)
+    for (std::size_t l = 0; l < 4; ++l)
     {
-      gap += c.weights[l] * (x.col(all[l]) + point.offset.col(all[l]));
-      relative += c.weights[l] * point.v.col(all[l]);
+      const int node = c.touch.nodes[l];
+      const double weight = c.touch.weights[l];
+      gap += weight * (x.col(node) + point.offset.col(node));
+      relative += weight * point.v.col(node);
       if (c.nodes[l] >= 0)
-        inverse_block += c.weights[l] * c.weights[l] /
+        inverse_block += weight * weight /
                          (c.sample >= 0 ? point.model.mass[c.nodes[l]] : system.diagonal(c.nodes[l]).trace() / 3.0);
     }
     c.depth = c.touch.depth - n.dot(gap - c.touch.gap);
@@ -157,8 +159,7 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
     c.block = c.scaled * (n * n.transpose());
     if (c.sample >= 0)
       relative += c.contact.velocity;
-    const double known = c.sample >= 0 ? sample_force_[static_cast<std::size_t>(c.sample)]
-                                       : hold_force_[static_cast<std::size_t>(c.touch.node)];
+    const double known = c.sample >= 0 ? sample_force_[static_cast<std::size_t>(c.sample)] : lastForce(c.touch);
     const double normal_force = std::max(block * c.depth / (h * h), known);
     Vec3 tangential;
     const double damping = frictionDamping(c.touch.friction, normal_force, relative, n, tangential);
@@ -171,7 +172,7 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
     }
     for (int l = 0; l < 4; ++l)
       if (c.nodes[l] >= 0)
-        system.rhs().col(c.nodes[l]) += c.weights[l] * push;
+        system.rhs().col(c.nodes[l]) += c.touch.weights[l] * push;
   }
 }
 
@@ -191,19 +192,15 @@ void SurfaceHolds::find(const NewtonPoint& point, const ContactQuery* colliders)
     // A hold that pushed in the last step is kept while the node stays within half its radius (or |g| h^2)
     // of the surface: released as soon as the push has set it moving off, it would fall back in the next
     // step and be pushed out again, a bounce every other step (seen at 1/240 s on a rope over an edge).
-    const double keep = std::max(margin, 0.5 * model.contact_radius[touch.node]);
-    if (touch.depth <= (hold_force_[static_cast<std::size_t>(touch.node)] > 0.0 ? -keep : 0.0))
+    const double keep = std::max(margin, 0.5 * model.contact_radius[touch.nodes[0]]);
+    if (touch.depth <= (lastForce(touch) > 0.0 ? -keep : 0.0))
       continue;
     Hold c;
     c.touch = touch;
     c.depth = c.scaled = 0.0;  // assemble sets them, and the block, each iteration
     c.block.setZero();
-    const int all[4] = { touch.node, touch.triangle[0], touch.triangle[1], touch.triangle[2] };
-    for (int l = 0; l < 4; ++l)
-    {
-      c.weights[l] = l == 0 ? 1.0 : -touch.weight[l - 1];
-      c.nodes[l] = model.isFree(all[l]) ? all[l] : -1;
-    }
+    for (std::size_t l = 0; l < 4; ++l)
+      c.nodes[l] = model.isFree(touch.nodes[l]) ? touch.nodes[l] : -1;
     holds_.push_back(c);
   }
 }
@@ -247,11 +244,11 @@ void SurfaceHolds::multiply(const Model&, const NodeArray& p, NodeArray& out) co
     Vec3 gap = Vec3::Zero();
     for (int l = 0; l < 4; ++l)
       if (c.nodes[l] >= 0)
-        gap += c.weights[l] * p.col(c.nodes[l]);
+        gap += c.touch.weights[l] * p.col(c.nodes[l]);
     const Vec3 pushed = c.block * gap;
     for (int l = 0; l < 4; ++l)
       if (c.nodes[l] >= 0)
-        out.col(c.nodes[l]) += c.weights[l] * pushed;
+        out.col(c.nodes[l]) += c.touch.weights[l] * pushed;
   }
 }
 
@@ -260,7 +257,16 @@ void SurfaceHolds::addToPreconditioner(const Model&, std::vector<Eigen::Matrix3d
   for (const Hold& c : holds_)
     for (int l = 0; l < 4; ++l)
       if (c.nodes[l] >= 0)
-        diagonal[static_cast<std::size_t>(c.nodes[l])] += (c.weights[l] * c.weights[l]) * c.block;
+        diagonal[static_cast<std::size_t>(c.nodes[l])] += (c.touch.weights[l] * c.touch.weights[l]) * c.block;
+}
+
+double SurfaceHolds::lastForce(const SurfaceTouch& touch) const
+{
+  if (touch.edges < 0)
+    return hold_force_[static_cast<std::size_t>(touch.nodes[0])];
+  const auto found = std::lower_bound(edge_force_.begin(), edge_force_.end(), touch.edges,
+                                      [](const auto& known, std::int64_t edges) { return known.first < edges; });
+  return found != edge_force_.end() && found->first == touch.edges ? found->second : 0.0;
 }
 
 double SurfaceHolds::force(const Hold& hold, double h, const NodeArray& dv)
@@ -268,7 +274,7 @@ double SurfaceHolds::force(const Hold& hold, double h, const NodeArray& dv)
   Vec3 moved = Vec3::Zero();
   for (int l = 0; l < 4; ++l)
     if (hold.nodes[l] >= 0)
-      moved += hold.weights[l] * dv.col(hold.nodes[l]);
+      moved += hold.touch.weights[l] * dv.col(hold.nodes[l]);
   return hold.scaled / (h * h) * (hold.depth - h * hold.touch.normal.dot(moved));
 }
 
@@ -286,12 +292,16 @@ void SurfaceHolds::noteForces(double h, const NodeArray& dv, ContactQuery* colli
     return;
   std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
   std::fill(sample_force_.begin(), sample_force_.end(), 0.0);
+  edge_force_.clear();
   for (const Hold& c : holds_)
   {
     const double normal_force = force(c, h, dv);
     if (c.sample < 0)
     {
-      hold_force_[static_cast<std::size_t>(c.touch.node)] = normal_force;
+      if (c.touch.edges >= 0)
+        edge_force_.emplace_back(c.touch.edges, normal_force);
+      else
+        hold_force_[static_cast<std::size_t>(c.touch.nodes[0])] = normal_force;
       continue;
     }
     sample_force_[static_cast<std::size_t>(c.sample)] = normal_force;
@@ -301,11 +311,12 @@ void SurfaceHolds::noteForces(double h, const NodeArray& dv, ContactQuery* colli
     Vec3 moved = Vec3::Zero();
     for (int l = 1; l < 4; ++l)
       if (c.nodes[l] >= 0)
-        moved += c.weights[l] * dv.col(c.nodes[l]);
+        moved += c.touch.weights[l] * dv.col(c.nodes[l]);
     const Vec3 n = c.touch.normal;
     const Vec3 on_point = normal_force * c.contact.normal + c.damping * (c.slip + moved - n.dot(moved) * n);
     colliders->receive(c.contact, -c.touch.gap - c.touch.depth * c.contact.normal, -h * on_point);
   }
+  std::sort(edge_force_.begin(), edge_force_.end());
 }
 
 }  // namespace soft_body_sim

@@ -5,14 +5,15 @@
 // cloth's, another solid's) whose predicted position lies within its contact radius of a solid's boundary
 // triangle, or behind it (SurfaceContacts::find), or, if its hold pushed in the last step, within
 // max(|g| h^2, r_p / 2) of that, is held by a one-sided spring on the gap g = n . (x_p - q) - r_p,
-// q = sum_k w_k x_k the triangle's nearest point at weights w: the Jacobian of g is weights_l n^T on the four
-// nodes, so the node and the triangle's nodes push each other apart with equal and opposite forces (momentum
-// kept) and A gains h^2 k weights_l weights_m n n^T. k is kContactStiffness times the contact's effective
-// mass b = 1 / sum_l weights_l^2 / b_l (b_l the free nodes' diagonal means): the solve leaves about
-// 1 / kContactStiffness of the depth. Coulomb friction damps their relative velocity across n as on a
+// q = sum_k w_k x_k the triangle's nearest point at weights w; and so is an edge of one solid near or across
+// an edge of another's, on the gap between their nearest points (SurfaceTouch). The Jacobian of g is
+// weights_l n^T on the four nodes, so the two sides push each other apart with equal and opposite forces
+// (momentum kept) and A gains h^2 k weights_l weights_m n n^T. k is kContactStiffness times the contact's
+// effective mass b = 1 / sum_l weights_l^2 / b_l (b_l the free nodes' diagonal means): the solve leaves
+// about 1 / kContactStiffness of the depth. Coulomb friction damps their relative velocity across n as on a
 // collider, pressed by max(b d / h^2, the hold's force in the last step), the solid's `friction` (two
-// solids': the mean). A hold couples a node to a triangle of another body: those node pairs join the
-// pattern when they first appear (placePairs).
+// solids': the mean). A hold couples a node to a triangle of another body, or two edges of two solids:
+// those node pairs join the pattern when they first appear (placePairs).
 //
 // A solid's surface samples (Model::surface_samples) are held on the colliders in the same rows, the collider in p's
 // place (no node, weight 0): a point q of a boundary triangle at fixed weights that is in a shape at x + h v is pushed
@@ -28,6 +29,7 @@
 #include <cstdint>
 #include <optional>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "core/contact/surface_contacts.h"
@@ -71,11 +73,12 @@ public:
       const Hold& c = holds_[k];
       for (int l = 0; l < 4; ++l)
         if (c.nodes[l] >= 0)
-          solver.addDiagonal(c.nodes[l], (c.weights[l] * c.weights[l]) * c.block);
+          solver.addDiagonal(c.nodes[l], (c.touch.weights[l] * c.touch.weights[l]) * c.block);
       for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
         if (slots_[kFourNodePairs.size() * k + p] >= 0)
           solver.addOffDiagonal(static_cast<std::size_t>(slots_[kFourNodePairs.size() * k + p]),
-                                (c.weights[kFourNodePairs[p].first] * c.weights[kFourNodePairs[p].second]) * c.block);
+                                (c.touch.weights[kFourNodePairs[p].first] * c.touch.weights[kFourNodePairs[p].second]) *
+                                    c.block);
     }
   }
 
@@ -87,9 +90,8 @@ public:
 private:
   struct Hold
   {
-    SurfaceTouch touch;  ///< as found at the step's first Newton iteration (node p, triangle, weights, n)
-    int nodes[4];        ///< p, then the triangle's three nodes, each -1 where pinned
-    double weights[4];   ///< 1, -w_0, -w_1, -w_2: the gap x_p - q = sum_l weights_l x_l
+    SurfaceTouch touch;  ///< as found at the step's first Newton iteration (its nodes, weights, n)
+    int nodes[4];        ///< touch.nodes, each -1 where pinned (or, for a sample, the collider's place)
     double depth;        ///< d [m] at this iteration's predicted positions
     double scaled;       ///< h^2 k [kg] in this iteration
     Eigen::Matrix3d block;  ///< B = h^2 k n n^T + h c (I - n n^T); A gains weights_l weights_m B on (l, m)
@@ -105,6 +107,8 @@ private:
   /// Holds every surface sample that is in a collider at x + h v (a triangle's points only where a collider
   /// comes within the triangle's reach).
   void findSamples(const NewtonPoint& point, const ContactQuery& colliders);
+  /// [N] the force the hold of a node or of two edges took in the last step (> 0 pushing), 0 if it had none.
+  double lastForce(const SurfaceTouch& touch) const;
   /// k (d - h n . sum_l weights_l dv_l) [N]: the force `hold` took in the Newton iteration that solved dv
   /// (> 0 pushing).
   static double force(const Hold& hold, double h, const NodeArray& dv);
@@ -129,6 +133,8 @@ private:
   std::vector<Hold> holds_;                  ///< the holds of the last Newton iteration
   /// per node: [N] the force its hold took in the last step (> 0 pushing, < 0 pulling), 0 without a hold
   std::vector<double> hold_force_;
+  /// the same for two edges' holds that had one in the last step: (SurfaceTouch::edges, [N]), by edges
+  std::vector<std::pair<std::int64_t, double>> edge_force_;
   NodeArray predicted_;                      ///< x + h v where holds are found [m]
   std::size_t element_pairs_ = 0;            ///< how many of the pattern's pairs are the elements'
   std::unordered_map<std::uint64_t, std::size_t> slot_of_pair_;  ///< a hold's node pair -> its slot
