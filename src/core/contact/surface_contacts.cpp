@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "core/contact/closest_points.h"
+#include "core/contact/face_contacts.h"
 
 namespace soft_body_sim
 {
@@ -66,19 +67,29 @@ SurfaceContacts::SurfaceContacts(const Model& model)
   for (std::size_t b = 0; b < model.bodies.size(); ++b)
     if (!model.bodies[b].surface.empty())
       solids_.push_back(b);
-  if (solids_.size() < 2)
-    return;  // no two solids: no edges meet
-  // Each solid's edges, each once, with the triangles on either side.
+  if (solids_.empty())
+    return;
+  for (std::size_t t = 0; t < model.contact_triangles.size();)
+  {
+    const std::size_t body = model.bodyOf(model.contact_triangles[t][0]);
+    std::size_t end = t + 1;
+    while (end < model.contact_triangles.size() && model.bodyOf(model.contact_triangles[end][0]) == body)
+      ++end;
+    if (model.bodies[body].surface.empty())
+      sheets_.push_back({ body, t, end });
+    t = end;
+  }
+  if (solids_.size() < 2 && sheets_.empty())
+    return;  // no edges meet
+  // Each surface's edges, each once, with a solid's triangles on either side.
   edges_first_.push_back(0);
   std::vector<std::tuple<int, int, int>> sides;  // (lower node, higher node, triangle)
-  for (const std::size_t s : solids_)
-  {
-    const std::vector<std::array<int, 3>>& surface = model.bodies[s].surface;
+  const auto add = [&](const std::array<int, 3>* triangles, std::size_t count, bool solid) {
     sides.clear();
-    for (std::size_t t = 0; t < surface.size(); ++t)
+    for (std::size_t t = 0; t < count; ++t)
       for (int k = 0; k < 3; ++k)
-        sides.emplace_back(std::min(surface[t][k], surface[t][(k + 1) % 3]),
-                           std::max(surface[t][k], surface[t][(k + 1) % 3]), static_cast<int>(t));
+        sides.emplace_back(std::min(triangles[t][k], triangles[t][(k + 1) % 3]),
+                           std::max(triangles[t][k], triangles[t][(k + 1) % 3]), static_cast<int>(t));
     std::sort(sides.begin(), sides.end());
     for (std::size_t i = 0; i < sides.size();)
     {
@@ -86,12 +97,16 @@ SurfaceContacts::SurfaceContacts(const Model& model)
       while (j < sides.size() && std::get<0>(sides[j]) == std::get<0>(sides[i]) &&
              std::get<1>(sides[j]) == std::get<1>(sides[i]))
         ++j;
-      edges_.push_back({ std::get<0>(sides[i]), std::get<1>(sides[i]), std::get<2>(sides[i]),
-                         j > i + 1 ? std::get<2>(sides[i + 1]) : -1 });
+      edges_.push_back({ std::get<0>(sides[i]), std::get<1>(sides[i]), solid ? std::get<2>(sides[i]) : -1,
+                         solid && j > i + 1 ? std::get<2>(sides[i + 1]) : -1 });
       i = j;
     }
     edges_first_.push_back(edges_.size());
-  }
+  };
+  for (const std::size_t s : solids_)
+    add(model.bodies[s].surface.data(), model.bodies[s].surface.size(), true);
+  for (const Sheet& sheet : sheets_)
+    add(model.contact_triangles.data() + sheet.first, sheet.end - sheet.first, false);
 }
 
 void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
@@ -176,9 +191,11 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
       }
     }
   }
+  if (edges_.empty())
+    return;
   // Two solids' edges, those of each in the other's box.
-  for (std::size_t i = 0; i + 1 < edges_first_.size(); ++i)
-    for (std::size_t j = i + 1; j + 1 < edges_first_.size(); ++j)
+  for (std::size_t i = 0; i < solids_.size(); ++i)
+    for (std::size_t j = i + 1; j < solids_.size(); ++j)
     {
       if (!finite(i) || !finite(j))
         continue;
@@ -188,15 +205,112 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
       edgesIn(j, x, predicted, low_[i], high_[i], near_second_);
       for (const std::size_t e : near_first_)
         for (const std::size_t f : near_second_)
-          touchEdges(model, x, predicted, margin, e, f, solids_[i], solids_[j], touches);
+          touchEdges(model, x, predicted, margin, e, f, solids_[i], solids_[j], false, touches);
     }
+  // A solid against a sheet in its box.
+  for (std::size_t k = 0; k < sheets_.size(); ++k)
+  {
+    const BodyRange& body = model.bodies[sheets_[k].body];
+    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 high = -low;
+    for (int p = body.first; p < body.first + body.count; ++p)
+    {
+      low = low.cwiseMin(x.col(p)).cwiseMin(predicted.col(p));
+      high = high.cwiseMax(x.col(p)).cwiseMax(predicted.col(p));
+    }
+    if (!low.allFinite() || !high.allFinite())
+      continue;
+    low.array() -= widest_ + margin;
+    high.array() += widest_ + margin;
+    for (std::size_t i = 0; i < solids_.size(); ++i)
+      if (finite(i) && (high.array() >= low_[i].array()).all() && (low.array() <= high_[i].array()).all())
+        touchSheet(model, x, predicted, margin, i, k, low, high, touches);
+  }
 }
 
-void SurfaceContacts::edgesIn(std::size_t solid, const NodeArray& x, const NodeArray& predicted, const Vec3& low,
+void SurfaceContacts::touchSheet(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
+                                 std::size_t i, std::size_t k, const Vec3& low, const Vec3& high,
+                                 std::vector<SurfaceTouch>& touches)
+{
+  const Sheet& sheet = sheets_[k];
+  const BodyRange& solid = model.bodies[solids_[i]];
+  near_triangles_.clear();
+  for (std::size_t t = sheet.first; t < sheet.end; ++t)
+  {
+    const std::array<int, 3>& triangle = model.contact_triangles[t];
+    const auto [least, most] = sweptBox(triangle[0], triangle[1], x, predicted);
+    const auto [least_c, most_c] = sweptBox(triangle[2], triangle[2], x, predicted);
+    if ((most.cwiseMax(most_c).array() >= low_[i].array()).all() &&
+        (least.cwiseMin(least_c).array() <= high_[i].array()).all())
+      near_triangles_.push_back(t);
+  }
+  if (near_triangles_.empty())
+    return;
+  // Its nodes, each against the nearest triangle: pushed off the face on the side it is on at x, or
+  // straight off the edge or corner nearest to it.
+  for (int p = solid.first; p < solid.first + solid.count; ++p)
+  {
+    const Vec3 at = x.col(p);
+    const auto in = [&](const Vec3& point) {
+      return (point.array() >= low.array()).all() && (point.array() <= high.array()).all();
+    };
+    if (!in(at) && !in(predicted.col(p)))
+      continue;
+    double nearest = std::numeric_limits<double>::infinity();
+    std::size_t over = 0;
+    TrianglePoint on{ Vec3::Zero(), Vec3::Zero() };
+    for (const std::size_t t : near_triangles_)
+    {
+      const std::array<int, 3>& triangle = model.contact_triangles[t];
+      const TrianglePoint candidate = nearestOnTriangle(at, x.col(triangle[0]), x.col(triangle[1]), x.col(triangle[2]));
+      const double distance = (at - candidate.point).squaredNorm();
+      if (distance < nearest)
+      {
+        nearest = distance;
+        over = t;
+        on = candidate;
+      }
+    }
+    if (!std::isfinite(nearest))
+      continue;
+    const std::array<int, 3>& corners = model.contact_triangles[over];
+    const Vec3 across = (x.col(corners[1]) - x.col(corners[0])).cross(x.col(corners[2]) - x.col(corners[0]));
+    const Vec3 gap = at - on.point;
+    Vec3 normal;
+    if (on.weight.minCoeff() > 0.0 && across.squaredNorm() > 0.0)
+      normal = (across.dot(gap) < 0.0 ? -1.0 : 1.0) * across.normalized();
+    else if (gap.squaredNorm() > 0.0)
+      normal = gap.normalized();
+    else
+      continue;  // on an edge exactly: no side to hold it on
+    const Vec3 weight = on.weight;
+    const std::array<int, 3>& triangle = model.contact_triangles[over];
+    const Vec3 predicted_gap = predicted.col(p) - weight[0] * predicted.col(triangle[0]) -
+                               weight[1] * predicted.col(triangle[1]) - weight[2] * predicted.col(triangle[2]);
+    const double depth = model.contact_radius[p] + triangleThickness(model, triangle) - normal.dot(predicted_gap);
+    if (depth > -margin)
+      touches.push_back({ { p, triangle[0], triangle[1], triangle[2] },
+                          { 1.0, -weight[0], -weight[1], -weight[2] },
+                          normal,
+                          predicted_gap,
+                          depth,
+                          solid.surface_friction });
+  }
+  // Its folds across the sheet's edges.
+  edgesIn(i, x, predicted, low, high, near_first_);
+  if (near_first_.empty())
+    return;
+  edgesIn(solids_.size() + k, x, predicted, low_[i], high_[i], near_second_);
+  for (const std::size_t e : near_first_)
+    for (const std::size_t f : near_second_)
+      touchEdges(model, x, predicted, margin, e, f, solids_[i], sheet.body, true, touches);
+}
+
+void SurfaceContacts::edgesIn(std::size_t k, const NodeArray& x, const NodeArray& predicted, const Vec3& low,
                               const Vec3& high, std::vector<std::size_t>& found) const
 {
   found.clear();
-  for (std::size_t e = edges_first_[solid]; e < edges_first_[solid + 1]; ++e)
+  for (std::size_t e = edges_first_[k]; e < edges_first_[k + 1]; ++e)
   {
     const auto [least, most] = sweptBox(edges_[e].a, edges_[e].b, x, predicted);
     if ((most.array() >= low.array()).all() && (least.array() <= high.array()).all())
@@ -205,13 +319,13 @@ void SurfaceContacts::edgesIn(std::size_t solid, const NodeArray& x, const NodeA
 }
 
 void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
-                                 std::size_t e, std::size_t f, std::size_t first, std::size_t second,
+                                 std::size_t e, std::size_t f, std::size_t first, std::size_t second, bool sheet,
                                  std::vector<SurfaceTouch>& touches) const
 {
   const Edge& one = edges_[e];
   const Edge& two = edges_[f];
-  const double radius = 0.25 * (model.contact_radius[one.a] + model.contact_radius[one.b] +
-                                model.contact_radius[two.a] + model.contact_radius[two.b]);
+  const double radius = 0.5 * (model.contact_radius[one.a] + model.contact_radius[one.b]) +
+                        0.5 * (model.contact_radius[two.a] + model.contact_radius[two.b]);
   const Vec3 a = x.col(one.a), along_one = x.col(one.b) - a;
   const Vec3 c = x.col(two.a), along_two = x.col(two.b) - c;
   const double deepest = kDeepestCrossing * std::sqrt(std::min(along_one.squaredNorm(), along_two.squaredNorm()));
@@ -227,7 +341,8 @@ void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const N
   const Vec3 across = along_one.cross(along_two);
   if (!(across.squaredNorm() > kNearParallelSine2 * along_one.squaredNorm() * along_two.squaredNorm()))
     return;
-  // Each edge's outward direction (its triangles' normals summed); both must be folds.
+  // Each solid edge's outward direction (its triangles' normals summed); both must be folds (a sheet's edge
+  // has no side: the solid's says which way n points).
   bool folds = true;
   const auto outward = [&](const Edge& edge, std::size_t body) {
     const std::vector<std::array<int, 3>>& surface = model.bodies[body].surface;
@@ -242,7 +357,7 @@ void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const N
     folds = folds && left.dot(right) < std::cos(kFold);
     return Vec3(left + right);
   };
-  const Vec3 out_one = outward(one, first), out_two = outward(two, second);
+  const Vec3 out_one = outward(one, first), out_two = sheet ? -out_one : outward(two, second);
   if (!folds)
     return;  // an edge inside a flat face: the other's nodes meet that face
   Vec3 normal = across.normalized();
@@ -261,7 +376,8 @@ void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const N
   const double depth = radius - normal.dot(predicted_gap);
   if (depth > -margin)
     touches.push_back({ nodes, weights, normal, predicted_gap, depth,
-                        0.5 * (model.bodies[first].surface_friction + model.bodies[second].surface_friction),
+                        sheet ? model.bodies[first].surface_friction
+                              : 0.5 * (model.bodies[first].surface_friction + model.bodies[second].surface_friction),
                         static_cast<std::int64_t>(e * edges_.size() + f) });
 }
 

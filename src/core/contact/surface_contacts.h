@@ -1,8 +1,9 @@
 // Where other bodies touch a soft solid's surface (`type: volume`): every node of another body (a rope's,
 // a cloth's, another solid's) that is within its contact radius of a solid's boundary triangles, or behind
-// them; and where two solids meet, every edge of one's boundary near or across an edge of the other's.
-// implicit_euler holds each such pair apart inside its Newton solve (see its surface holds). A scene with no
-// solid, or with a solid and no other body, has no finder and pays nothing.
+// them; where two solids meet, every fold of one's boundary near or across a fold of the other's; and where
+// a solid meets a cloth's (or a jelly's) contact triangles, the solid's nodes over them and its folds across
+// their edges. implicit_euler holds each such pair apart inside its Newton solve (see its surface holds). A
+// scene with no solid, or with a solid and no other body, has no finder and pays nothing.
 #pragma once
 
 #include <array>
@@ -29,12 +30,13 @@ TrianglePoint nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, con
 /// x_(nodes_l) between the two points that touch:
 /// - a node p of one body near or behind a boundary triangle of a solid: nodes (p, the triangle's three),
 ///   weights (1, -w_0, -w_1, -w_2), so g = x_p - q with q the triangle's point nearest to p at weights w;
-/// - an edge (a, b) of one solid's boundary near or across an edge (c, d) of another's: nodes (a, b, c, d),
-///   weights (1 - s, s, -(1 - t), -t), so g is the first edge's point minus the second's, s and t where the
-///   edges come closest.
+/// - a node p of a solid near a cloth's contact triangle: the same, the triangle the cloth's;
+/// - an edge (a, b) of one solid's boundary near or across an edge (c, d) of another's, or of a cloth's
+///   contact triangles: nodes (a, b, c, d), weights (1 - s, s, -(1 - t), -t), so g is the first edge's
+///   point minus the second's, s and t where the edges come closest.
 /// n is the direction along which the first point is held out (from the triangle, or from the second
-/// edge), d = r - n . g its depth (> 0: closer than r, or behind), r the node's contact radius or the
-/// edges' nodes' mean.
+/// edge), d = r - n . g its depth (> 0: closer than r, or behind). r is the node's contact radius (and the
+/// cloth triangle's thickness, its nodes' mean radius), or the sum of the two edges' nodes' mean radii.
 struct SurfaceTouch
 {
   std::array<int, 4> nodes;
@@ -81,6 +83,12 @@ public:
   /// came. Pairs crossed by more than kDeepestCrossing of the shorter edge are left (no longer a contact of
   /// those edges).
   ///
+  /// A solid meets a cloth's (or a jelly's) contact triangles, two-sided sheets as thick as their nodes'
+  /// contact radii, with its nodes and its folds: a node over a triangle (its projection inside it) is held
+  /// on the side of the nearest such triangle it is on at x; a fold across an edge of the triangles, along
+  /// the common normal pointing into the solid. So a cloth draped over a soft box does not let the box's
+  /// rims and corners through between its nodes.
+  ///
   /// The depth is at the `predicted` positions (x + h v), d = r - n . g, and a pair is kept when
   /// d > -margin. Nodes and edges outside the other solid's bounding box now and predicted, widened by the
   /// largest contact radius and the margin, are skipped without looking at a triangle or an edge.
@@ -108,18 +116,36 @@ private:
     int a, b;
     int left, right;
   };
-  /// The edges of `solid`'s boundary in `edges_` that lie in the box [low, high] now or predicted.
-  void edgesIn(std::size_t solid, const NodeArray& x, const NodeArray& predicted, const Vec3& low, const Vec3& high,
+  /// A body with contact triangles and no surface (a cloth, a jelly with face_contacts): its triangles are
+  /// Model::contact_triangles [first, end).
+  struct Sheet
+  {
+    std::size_t body;
+    std::size_t first, end;
+  };
+  /// The edges of a surface (k < solids_.size(): solids_[k]'s boundary, else sheets_[k - solids_.size()]'s
+  /// triangles) in `edges_` that lie in the box [low, high] now or predicted.
+  void edgesIn(std::size_t k, const NodeArray& x, const NodeArray& predicted, const Vec3& low, const Vec3& high,
                std::vector<std::size_t>& found) const;
-  /// Edges e and f of two solids (indices into edges_; Model::bodies `first` and `second`) into `touches` if
-  /// they touch (find).
+  /// Edges e and f (indices into edges_), e a solid's (Model::bodies `first`), f another solid's (`second`)
+  /// or, if `sheet`, a sheet's, into `touches` if they touch (find).
   void touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t e,
-                  std::size_t f, std::size_t first, std::size_t second, std::vector<SurfaceTouch>& touches) const;
+                  std::size_t f, std::size_t first, std::size_t second, bool sheet,
+                  std::vector<SurfaceTouch>& touches) const;
+  /// solids_[i] against sheets_[k] (find): its nodes over the sheet's triangles, its folds across their
+  /// edges; [low, high] the sheet's box.
+  void touchSheet(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t i,
+                  std::size_t k, const Vec3& low, const Vec3& high, std::vector<SurfaceTouch>& touches);
 
   double widest_;                    ///< widestRadius()
   std::vector<std::size_t> solids_;  ///< bodies with a surface (Model::bodies), when another body exists
-  std::vector<Edge> edges_;          ///< every solid's boundary edges, each once, a solid's in a run
-  std::vector<std::size_t> edges_first_;  ///< per entry of solids_, its first edge in edges_ (and one past the last)
+  std::vector<Sheet> sheets_;        ///< bodies with contact triangles and no surface, when a solid exists
+  /// the edges of two or more solids' boundaries, and of the sheets' triangles if there is a solid, each once,
+  /// a surface's in a run (a sheet's edges have no triangles: left and right -1)
+  std::vector<Edge> edges_;
+  /// per surface (solids_, then sheets_), its first edge in edges_ (and one past the last)
+  std::vector<std::size_t> edges_first_;
+  std::vector<std::size_t> near_triangles_;  ///< touchSheet's triangles in the solid's box
   std::vector<Vec3> low_, high_;     ///< find's boxes around the solids (per entry of solids_)
   std::vector<std::size_t> near_first_, near_second_;  ///< find's edges in the other solid's box
 };
