@@ -19,6 +19,20 @@ std::pair<Vec3, Vec3> sweptBox(int a, int b, const NodeArray& x, const NodeArray
   return { x.col(a).cwiseMin(x.col(b)).cwiseMin(predicted.col(a)).cwiseMin(predicted.col(b)),
            x.col(a).cwiseMax(x.col(b)).cwiseMax(predicted.col(a)).cwiseMax(predicted.col(b)) };
 }
+
+/// The box (low, high) around a body's nodes now (x) and predicted, widened by `widen` [m]; not finite if a
+/// position is not (the divergence guard's case).
+std::pair<Vec3, Vec3> bodyBox(const BodyRange& body, const NodeArray& x, const NodeArray& predicted, double widen)
+{
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 high = -low;
+  for (int p = body.first; p < body.first + body.count; ++p)
+  {
+    low = low.cwiseMin(x.col(p)).cwiseMin(predicted.col(p));
+    high = high.cwiseMax(x.col(p)).cwiseMax(predicted.col(p));
+  }
+  return { low.array() - widen, high.array() + widen };
+}
 }  // namespace
 
 TrianglePoint nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
@@ -120,18 +134,7 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
   low_.resize(solids_.size());
   high_.resize(solids_.size());
   for (std::size_t i = 0; i < solids_.size(); ++i)
-  {
-    const BodyRange& solid = model.bodies[solids_[i]];
-    low_[i] = Vec3::Constant(std::numeric_limits<double>::infinity());
-    high_[i] = -low_[i];
-    for (int p = solid.first; p < solid.first + solid.count; ++p)
-    {
-      low_[i] = low_[i].cwiseMin(x.col(p)).cwiseMin(predicted.col(p));
-      high_[i] = high_[i].cwiseMax(x.col(p)).cwiseMax(predicted.col(p));
-    }
-    low_[i].array() -= widest_ + margin;
-    high_[i].array() += widest_ + margin;
-  }
+    std::tie(low_[i], high_[i]) = bodyBox(model.bodies[solids_[i]], x, predicted, widest_ + margin);
   const auto finite = [&](std::size_t i) { return low_[i].allFinite() && high_[i].allFinite(); };
   for (std::size_t i = 0; i < solids_.size(); ++i)
   {
@@ -210,18 +213,9 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
   // A solid against a sheet in its box.
   for (std::size_t k = 0; k < sheets_.size(); ++k)
   {
-    const BodyRange& body = model.bodies[sheets_[k].body];
-    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
-    Vec3 high = -low;
-    for (int p = body.first; p < body.first + body.count; ++p)
-    {
-      low = low.cwiseMin(x.col(p)).cwiseMin(predicted.col(p));
-      high = high.cwiseMax(x.col(p)).cwiseMax(predicted.col(p));
-    }
+    const auto [low, high] = bodyBox(model.bodies[sheets_[k].body], x, predicted, widest_ + margin);
     if (!low.allFinite() || !high.allFinite())
       continue;
-    low.array() -= widest_ + margin;
-    high.array() += widest_ + margin;
     for (std::size_t i = 0; i < solids_.size(); ++i)
       if (finite(i) && (high.array() >= low_[i].array()).all() && (low.array() <= high_[i].array()).all())
         touchSheet(model, x, predicted, margin, i, k, low, high, touches);
