@@ -31,14 +31,14 @@ BodyDef cube(const std::string& name, double size, const Vec3& centre, double yo
   return buildVolume(name, box);
 }
 
-/// A 40 cm rope of radius `radius` [m] (41 nodes, 20 g) along x, 5 cm above a cube of edge `size` [m] whose
-/// bottom is at z = 0.
-BodyDef ropeAcross(double size, double radius)
+/// A 40 cm rope of radius `radius` [m] (41 nodes, 20 g) along x at y = `y` [m], 5 cm above a cube of edge
+/// `size` [m] whose bottom is at z = 0.
+BodyDef ropeAcross(double size, double radius, double y = 0.0)
 {
   RopeDef rope;
   rope.nodes = 41;
-  rope.from = Vec3(-0.2, 0.0, size + 0.05);
-  rope.to = Vec3(0.2, 0.0, size + 0.05);
+  rope.from = Vec3(-0.2, y, size + 0.05);
+  rope.to = Vec3(0.2, y, size + 0.05);
   rope.mass = 0.02;
   rope.stiffness = 200.0;
   rope.damping = 0.05;
@@ -390,44 +390,61 @@ TEST(SurfaceContacts, AClothDrapedOverACubeKeepsItsThicknessFromTheCubesRimsAndC
 
 TEST(SurfaceContacts, ARopeDroppedAcrossACubeRestsOnItsTopAndNeverEntersIt)
 {
-  // A 40 cm rope of radius 5 mm (41 nodes, 20 g) dropped from 5 cm above a 10 cm foam cube resting on the
-  // floor, across its middle: it lands on the top face at 1 m/s and hangs down both sides. Each hold's
-  // normal is kept through its step, while the rope turns around the cube's top edges within a step
-  // (16 mm at 1/60 s), so that in the landing a node may come within 0.78 r of an edge at 1/60 s (measured);
-  // never inside, never nearer than 0.7 r (0.998 r at 1/240 s). At rest no node is nearer than 0.995 r
-  // (0.9976 r at 1/60 s, 0.9999 r at 1/240 s), and the rope's middle lies on the top face at its radius.
+  // A 40 cm rope of radius 5 mm (41 nodes 1 cm apart, 20 g) dropped from 5 cm above a 10 cm foam cube
+  // resting on the floor, across its middle: it lands on the top face at 1 m/s and hangs down both sides,
+  // bent round the cube's rims. Across a rim node (y = 0) and between two (y = 6.25 mm; the rim's nodes
+  // are 12.5 mm apart). Truth: the nearest that any point of the rope's axis (its nodes and 15 points
+  // between each two) comes to the cube's surface (signedDistance), against its radius r. Its segments
+  // meet the cube's rim nodes and rims, not only its nodes the cube's faces: at rest the axis keeps r from
+  // the cube within 1 % (measured: 0.995 r at 1/60 s and 0.992 r at 1/240 s over a rim node, 0.9996 r and
+  // 0.9998 r between two); by its nodes alone the chords over the rims came to 0.58 r and 0.38 r over a rim
+  // node, 0.49 r and 0.38 r between two. Each hold's normal is kept through its step, while the rope turns
+  // round the rims within a step (16 mm at 1/60 s), so that in the landing the axis comes to 0.71 r and
+  // 0.69 r over a rim node, 0.39 r and 0.78 r between two (by its nodes alone 0.44 r and 0.38 r, 0.45 r and
+  // 0.38 r): never inside, never nearer than 0.6 r over a rim node and 0.35 r between two. The rope's middle
+  // lies on the top face at its radius.
   const double size = 0.1, radius = 0.005;
-  for (const double dt : { 1.0 / 60.0, 1.0 / 240.0 })
+  struct Case
   {
-    SceneDef scene = floorScene(dt);
-    scene.physics.drag = 1.0;
-    scene.bodies = { cube("cube", size, Vec3(0.0, 0.0, 0.5 * size), 5.0e4, 0.3, 100.0, 0.5), ropeAcross(size, radius) };
-    World world = buildWorld(scene);
-    const BodyRange& solid = world.model().bodies[0];
-    const BodyRange& line = world.model().bodies[1];
-    const auto closest = [&]() {
-      double nearest = INFINITY;
-      for (int i = line.first; i < line.first + line.count; ++i)
-        nearest = std::min(nearest, signedDistance(solid, world.state().position, world.state().position.col(i)));
-      return nearest;
-    };
-    double landing = INFINITY;
-    for (int step = 0; step < static_cast<int>(std::lround(10.0 / dt)); ++step)
+    double y, landing;
+  };
+  for (const Case& c : { Case{ 0.0, 0.6 }, Case{ 0.00625, 0.35 } })
+    for (const double dt : { 1.0 / 60.0, 1.0 / 240.0 })
     {
-      world.step();
-      ASSERT_TRUE(allFinite(world.state()));
-      landing = std::min(landing, closest());
+      SceneDef scene = floorScene(dt);
+      scene.physics.drag = 1.0;
+      scene.bodies = { cube("cube", size, Vec3(0.0, 0.0, 0.5 * size), 5.0e4, 0.3, 100.0, 0.5),
+                       ropeAcross(size, radius, c.y) };
+      World world = buildWorld(scene);
+      const BodyRange& solid = world.model().bodies[0];
+      const BodyRange& line = world.model().bodies[1];
+      const auto closest = [&]() {
+        const NodeArray& x = world.state().position;
+        double nearest = INFINITY;
+        for (int i = line.first; i + 1 < line.first + line.count; ++i)
+          for (int k = 0; k <= 16; ++k)
+            nearest = std::min(nearest, signedDistance(solid, x, x.col(i) + (x.col(i + 1) - x.col(i)) * (k / 16.0)));
+        return nearest;
+      };
+      const std::string at = "y " + std::to_string(c.y) + ", dt " + std::to_string(dt);
+      double landing = INFINITY;
+      for (int step = 0; step < static_cast<int>(std::lround(10.0 / dt)); ++step)
+      {
+        world.step();
+        ASSERT_TRUE(allFinite(world.state())) << at;
+        if (step * dt < 1.0)
+          landing = std::min(landing, closest());
+      }
+      EXPECT_GT(landing, c.landing * radius) << at;
+      EXPECT_GT(closest(), 0.99 * radius) << at;
+      const int middle = line.first + 20;
+      EXPECT_NEAR(world.state().position(2, middle), meanZ(world, 0, scene.bodies[0], size) + radius, 0.02 * radius)
+          << at;
+      EXPECT_LT(world.state().velocity.colwise().norm().maxCoeff(), 1e-3) << at;
+      // Its ends hang down the cube's sides, below its top.
+      EXPECT_LT(world.state().position(2, line.first), size - 0.05) << at;
+      EXPECT_LT(world.state().position(2, line.first + line.count - 1), size - 0.05) << at;
     }
-    EXPECT_GT(landing, 0.7 * radius) << "dt " << dt;
-    EXPECT_GT(closest(), 0.995 * radius) << "dt " << dt;
-    const int middle = line.first + 20;
-    EXPECT_NEAR(world.state().position(2, middle), meanZ(world, 0, scene.bodies[0], size) + radius, 0.02 * radius)
-        << "dt " << dt;
-    EXPECT_LT(world.state().velocity.colwise().norm().maxCoeff(), 1e-3) << "dt " << dt;
-    // Its ends hang down the cube's sides, below its top.
-    EXPECT_LT(world.state().position(2, line.first), size - 0.05) << "dt " << dt;
-    EXPECT_LT(world.state().position(2, line.first + line.count - 1), size - 0.05) << "dt " << dt;
-  }
 }
 
 TEST(SurfaceContacts, ARopeRestsOnAPinnedBlockWhoseFreeNodesFormChains)
@@ -437,6 +454,9 @@ TEST(SurfaceContacts, ARopeRestsOnAPinnedBlockWhoseFreeNodesFormChains)
   // triangles. The 40 cm rope of radius 5 mm dropped across the 10 cm block comes to rest on its top face
   // at its radius and never enters it, at both steps. The same with two neighbouring nodes of the top face
   // left free under the rope: their pair and the rope again form chains, and the block gives under it.
+  // Its axis (nodes and 15 points between each two) keeps within 1 % of r at rest (0.9999 r to r; by its
+  // nodes alone the chords over the rims came to 0.38 to 0.54 r) and, landing, comes no nearer than 0.6 r
+  // (0.72 to 0.86 r measured), as in the test above.
   const double size = 0.1, radius = 0.005;
   for (const bool two_free : { false, true })
     for (const double dt : { 1.0 / 60.0, 1.0 / 240.0 })
@@ -472,15 +492,25 @@ TEST(SurfaceContacts, ARopeRestsOnAPinnedBlockWhoseFreeNodesFormChains)
       const BodyRange& line = world.model().bodies[1];
       const std::string at = std::string(two_free ? "two free nodes" : "pinned") + ", dt " + std::to_string(dt);
       const auto distance = [&](int i) { return signedDistance(solid, world.state().position, world.state().position.col(i)); };
+      // The nearest point of the rope's axis (its nodes and 15 points between each two).
+      const auto closest = [&]() {
+        const NodeArray& x = world.state().position;
+        double nearest = INFINITY;
+        for (int i = line.first; i + 1 < line.first + line.count; ++i)
+          for (int k = 0; k <= 16; ++k)
+            nearest = std::min(nearest, signedDistance(solid, x, x.col(i) + (x.col(i + 1) - x.col(i)) * (k / 16.0)));
+        return nearest;
+      };
       double landing = INFINITY;
       for (int step = 0; step < static_cast<int>(std::lround(5.0 / dt)); ++step)
       {
         world.step();
         ASSERT_TRUE(allFinite(world.state())) << at;
-        for (int i = line.first; i < line.first + line.count; ++i)
-          landing = std::min(landing, distance(i));
+        if (step * dt < 1.0)  // the landing
+          landing = std::min(landing, closest());
       }
-      EXPECT_GT(landing, 0.7 * radius) << at;
+      EXPECT_GT(landing, 0.6 * radius) << at;
+      EXPECT_GT(closest(), 0.99 * radius) << at;
       EXPECT_NEAR(distance(line.first + 20), radius, 0.02 * radius) << at;
       EXPECT_LT(world.state().velocity.colwise().norm().maxCoeff(), 1e-3) << at;
     }

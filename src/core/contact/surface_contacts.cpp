@@ -90,12 +90,22 @@ SurfaceContacts::SurfaceContacts(const Model& model)
     while (end < model.contact_triangles.size() && model.bodyOf(model.contact_triangles[end][0]) == body)
       ++end;
     if (model.bodies[body].surface.empty())
-      sheets_.push_back({ body, t, end });
+      thin_.push_back({ body, true, t, end });
     t = end;
   }
-  if (solids_.size() < 2 && sheets_.empty())
+  for (std::size_t s = 0; s < model.contact_segments.size();)
+  {
+    const std::size_t body = model.bodyOf(model.contact_segments[s].first);
+    std::size_t end = s + 1;
+    while (end < model.contact_segments.size() && model.bodyOf(model.contact_segments[end].first) == body)
+      ++end;
+    if (model.bodies[body].surface.empty())
+      thin_.push_back({ body, false, s, end });
+    s = end;
+  }
+  if (solids_.size() < 2 && thin_.empty())
     return;  // no edges meet
-  // Each surface's edges, each once, with a solid's triangles on either side.
+  // Each body's edges, each once, with a solid's triangles on either side.
   edges_first_.push_back(0);
   std::vector<std::tuple<int, int, int>> sides;  // (lower node, higher node, triangle)
   const auto add = [&](const std::array<int, 3>* triangles, std::size_t count, bool solid) {
@@ -119,8 +129,17 @@ SurfaceContacts::SurfaceContacts(const Model& model)
   };
   for (const std::size_t s : solids_)
     add(model.bodies[s].surface.data(), model.bodies[s].surface.size(), true);
-  for (const Sheet& sheet : sheets_)
-    add(model.contact_triangles.data() + sheet.first, sheet.end - sheet.first, false);
+  for (const Thin& thin : thin_)
+  {
+    if (thin.triangles)
+    {
+      add(model.contact_triangles.data() + thin.first, thin.end - thin.first, false);
+      continue;
+    }
+    for (std::size_t s = thin.first; s < thin.end; ++s)
+      edges_.push_back({ model.contact_segments[s].first, model.contact_segments[s].second, -1, -1 });
+    edges_first_.push_back(edges_.size());
+  }
 }
 
 void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
@@ -210,26 +229,27 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
         for (const std::size_t f : near_second_)
           touchEdges(model, x, predicted, margin, e, f, solids_[i], solids_[j], false, touches);
     }
-  // A solid against a sheet in its box.
-  for (std::size_t k = 0; k < sheets_.size(); ++k)
+  // A solid against a thin body in its box.
+  for (std::size_t k = 0; k < thin_.size(); ++k)
   {
-    const auto [low, high] = bodyBox(model.bodies[sheets_[k].body], x, predicted, widest_ + margin);
+    const auto [low, high] = bodyBox(model.bodies[thin_[k].body], x, predicted, widest_ + margin);
     if (!low.allFinite() || !high.allFinite())
       continue;
     for (std::size_t i = 0; i < solids_.size(); ++i)
       if (finite(i) && (high.array() >= low_[i].array()).all() && (low.array() <= high_[i].array()).all())
-        touchSheet(model, x, predicted, margin, i, k, low, high, touches);
+        touchThin(model, x, predicted, margin, i, k, low, high, touches);
   }
 }
 
-void SurfaceContacts::touchSheet(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
-                                 std::size_t i, std::size_t k, const Vec3& low, const Vec3& high,
-                                 std::vector<SurfaceTouch>& touches)
+void SurfaceContacts::touchThin(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
+                                std::size_t i, std::size_t k, const Vec3& low, const Vec3& high,
+                                std::vector<SurfaceTouch>& touches)
 {
-  const Sheet& sheet = sheets_[k];
+  const Thin& thin = thin_[k];
   const BodyRange& solid = model.bodies[solids_[i]];
+  // Its triangles, or its segments, in the solid's box.
   near_triangles_.clear();
-  for (std::size_t t = sheet.first; t < sheet.end; ++t)
+  for (std::size_t t = thin.first; thin.triangles && t < thin.end; ++t)
   {
     const std::array<int, 3>& triangle = model.contact_triangles[t];
     const auto [least, most] = sweptBox(triangle[0], triangle[1], x, predicted);
@@ -238,21 +258,40 @@ void SurfaceContacts::touchSheet(const Model& model, const NodeArray& x, const N
         (least.cwiseMin(least_c).array() <= high_[i].array()).all())
       near_triangles_.push_back(t);
   }
-  if (near_triangles_.empty())
+  edgesIn(solids_.size() + k, x, predicted, low_[i], high_[i], near_second_);
+  if (near_second_.empty())
     return;
-  // Its nodes, each against the nearest triangle: pushed off the face on the side it is on at x, or
-  // straight off the edge or corner nearest to it.
+  if (!thin.triangles)
+  {
+    // Against segments only the solid's nodes on a fold (a rim's, a corner's: where a segment's chord can
+    // cut in between the segment's nodes; on a flat face the segment's nodes meet the face), each with its
+    // outward direction (its triangles' normals summed).
+    outward_.resize(3, model.nodeCount());
+    on_fold_.assign(static_cast<std::size_t>(model.nodeCount()), false);
+    outward_.middleCols(solid.first, solid.count).setZero();
+    for (const std::array<int, 3>& t : solid.surface)
+    {
+      const Vec3 normal = (x.col(t[1]) - x.col(t[0])).cross(x.col(t[2]) - x.col(t[0])).normalized();
+      for (const int node : t)
+        outward_.col(node) += normal;
+    }
+    for (std::size_t e = edges_first_[i]; e < edges_first_[i + 1]; ++e)
+      if (isFold(model, x, solids_[i], edges_[e]))
+        on_fold_[static_cast<std::size_t>(edges_[e].a)] = on_fold_[static_cast<std::size_t>(edges_[e].b)] = true;
+  }
+  // Its nodes, each against the nearest triangle or segment: pushed off a triangle's face on the side it is
+  // on at x, or straight off the nearest edge, corner or segment's axis.
   for (int p = solid.first; p < solid.first + solid.count; ++p)
   {
     const Vec3 at = x.col(p);
     const auto in = [&](const Vec3& point) {
       return (point.array() >= low.array()).all() && (point.array() <= high.array()).all();
     };
-    if (!in(at) && !in(predicted.col(p)))
+    if ((!in(at) && !in(predicted.col(p))) || (!thin.triangles && !on_fold_[static_cast<std::size_t>(p)]))
       continue;
     double nearest = std::numeric_limits<double>::infinity();
-    std::size_t over = 0;
-    TrianglePoint on{ Vec3::Zero(), Vec3::Zero() };
+    std::array<int, 3> corners{};
+    Vec3 on = Vec3::Zero(), weight = Vec3::Zero();
     for (const std::size_t t : near_triangles_)
     {
       const std::array<int, 3>& triangle = model.contact_triangles[t];
@@ -261,43 +300,82 @@ void SurfaceContacts::touchSheet(const Model& model, const NodeArray& x, const N
       if (distance < nearest)
       {
         nearest = distance;
-        over = t;
-        on = candidate;
+        corners = triangle;
+        on = candidate.point;
+        weight = candidate.weight;
+      }
+    }
+    for (std::size_t n = 0; !thin.triangles && n < near_second_.size(); ++n)
+    {
+      const Edge& segment = edges_[near_second_[n]];
+      const Vec3 c = x.col(segment.a), along = x.col(segment.b) - c;
+      const double t = closestSegmentParameters(at, Vec3::Zero(), c, along).second;
+      const double distance = (at - c - t * along).squaredNorm();
+      if (distance < nearest)
+      {
+        nearest = distance;
+        corners = { segment.a, segment.b, segment.b };  // the third of weight 0
+        on = c + t * along;
+        weight = Vec3(1.0 - t, t, 0.0);
       }
     }
     if (!std::isfinite(nearest))
       continue;
-    const std::array<int, 3>& corners = model.contact_triangles[over];
-    const Vec3 across = (x.col(corners[1]) - x.col(corners[0])).cross(x.col(corners[2]) - x.col(corners[0]));
-    const Vec3 gap = at - on.point;
+    const Vec3 gap = at - on;
+    const Vec3 across = thin.triangles
+                            ? Vec3((x.col(corners[1]) - x.col(corners[0])).cross(x.col(corners[2]) - x.col(corners[0])))
+                            : Vec3::Zero();
     Vec3 normal;
-    if (on.weight.minCoeff() > 0.0 && across.squaredNorm() > 0.0)
+    if (weight.minCoeff() > 0.0 && across.squaredNorm() > 0.0)
       normal = (across.dot(gap) < 0.0 ? -1.0 : 1.0) * across.normalized();
     else if (gap.squaredNorm() > 0.0)
       normal = gap.normalized();
     else
-      continue;  // on an edge exactly: no side to hold it on
-    const Vec3 weight = on.weight;
-    const std::array<int, 3>& triangle = model.contact_triangles[over];
-    const Vec3 predicted_gap = predicted.col(p) - weight[0] * predicted.col(triangle[0]) -
-                               weight[1] * predicted.col(triangle[1]) - weight[2] * predicted.col(triangle[2]);
-    const double depth = model.contact_radius[p] + triangleThickness(model, triangle) - normal.dot(predicted_gap);
+      continue;  // on an edge or axis exactly: no side to hold it on
+    // Off a segment's axis into the solid: a node that faces away from the axis is not the segment's to
+    // hold (the segment lies beyond the solid, or the node is past its axis already).
+    if (!thin.triangles && !(normal.dot(outward_.col(p)) < 0.0))
+      continue;
+    const Vec3 predicted_gap = predicted.col(p) - weight[0] * predicted.col(corners[0]) -
+                               weight[1] * predicted.col(corners[1]) - weight[2] * predicted.col(corners[2]);
+    // The triangle's thickness, or the segment's radius at its point.
+    const double thickness = thin.triangles ? triangleThickness(model, corners)
+                                            : weight[0] * model.contact_radius[corners[0]] +
+                                                  weight[1] * model.contact_radius[corners[1]];
+    const double depth = model.contact_radius[p] + thickness - normal.dot(predicted_gap);
     if (depth > -margin)
-      touches.push_back({ { p, triangle[0], triangle[1], triangle[2] },
+      touches.push_back({ { p, corners[0], corners[1], corners[2] },
                           { 1.0, -weight[0], -weight[1], -weight[2] },
                           normal,
                           predicted_gap,
                           depth,
                           solid.surface_friction });
   }
-  // Its folds across the sheet's edges.
+  // Its folds across the triangles' edges or the segments.
   edgesIn(i, x, predicted, low, high, near_first_);
-  if (near_first_.empty())
-    return;
-  edgesIn(solids_.size() + k, x, predicted, low_[i], high_[i], near_second_);
   for (const std::size_t e : near_first_)
     for (const std::size_t f : near_second_)
-      touchEdges(model, x, predicted, margin, e, f, solids_[i], sheet.body, true, touches);
+      touchEdges(model, x, predicted, margin, e, f, solids_[i], thin.body, true, touches);
+}
+
+std::pair<Vec3, Vec3> SurfaceContacts::sideNormals(const Model& model, const NodeArray& x, std::size_t body,
+                                                   const Edge& edge)
+{
+  const std::vector<std::array<int, 3>>& surface = model.bodies[body].surface;
+  const auto normal = [&](int triangle) {
+    const std::array<int, 3>& k = surface[static_cast<std::size_t>(triangle)];
+    return Vec3((x.col(k[1]) - x.col(k[0])).cross(x.col(k[2]) - x.col(k[0])).normalized());
+  };
+  const Vec3 left = normal(edge.left);
+  return { left, edge.right < 0 ? left : normal(edge.right) };
+}
+
+bool SurfaceContacts::isFold(const Model& model, const NodeArray& x, std::size_t body, const Edge& edge)
+{
+  if (edge.right < 0)
+    return true;  // an open surface's rim
+  const auto [left, right] = sideNormals(model, x, body, edge);
+  return left.dot(right) < std::cos(kFold);
 }
 
 void SurfaceContacts::edgesIn(std::size_t k, const NodeArray& x, const NodeArray& predicted, const Vec3& low,
@@ -313,7 +391,7 @@ void SurfaceContacts::edgesIn(std::size_t k, const NodeArray& x, const NodeArray
 }
 
 void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
-                                 std::size_t e, std::size_t f, std::size_t first, std::size_t second, bool sheet,
+                                 std::size_t e, std::size_t f, std::size_t first, std::size_t second, bool thin,
                                  std::vector<SurfaceTouch>& touches) const
 {
   const Edge& one = edges_[e];
@@ -335,23 +413,15 @@ void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const N
   const Vec3 across = along_one.cross(along_two);
   if (!(across.squaredNorm() > kNearParallelSine2 * along_one.squaredNorm() * along_two.squaredNorm()))
     return;
-  // Each solid edge's outward direction (its triangles' normals summed); both must be folds (a sheet's edge
-  // has no side: the solid's says which way n points).
+  // Each solid edge's outward direction (its triangles' normals summed); both must be folds (a thin body's
+  // edge has no side: the solid's says which way n points).
   bool folds = true;
   const auto outward = [&](const Edge& edge, std::size_t body) {
-    const std::vector<std::array<int, 3>>& surface = model.bodies[body].surface;
-    const auto normal = [&](int triangle) {
-      const std::array<int, 3>& k = surface[static_cast<std::size_t>(triangle)];
-      return Vec3((x.col(k[1]) - x.col(k[0])).cross(x.col(k[2]) - x.col(k[0])).normalized());
-    };
-    const Vec3 left = normal(edge.left);
-    if (edge.right < 0)
-      return left;  // an open surface's rim
-    const Vec3 right = normal(edge.right);
-    folds = folds && left.dot(right) < std::cos(kFold);
-    return Vec3(left + right);
+    folds = folds && isFold(model, x, body, edge);
+    const auto [left, right] = sideNormals(model, x, body, edge);
+    return edge.right < 0 ? left : Vec3(left + right);
   };
-  const Vec3 out_one = outward(one, first), out_two = sheet ? -out_one : outward(two, second);
+  const Vec3 out_one = outward(one, first), out_two = thin ? -out_one : outward(two, second);
   if (!folds)
     return;  // an edge inside a flat face: the other's nodes meet that face
   Vec3 normal = across.normalized();
@@ -370,7 +440,7 @@ void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const N
   const double depth = radius - normal.dot(predicted_gap);
   if (depth > -margin)
     touches.push_back({ nodes, weights, normal, predicted_gap, depth,
-                        sheet ? model.bodies[first].surface_friction
+                        thin ? model.bodies[first].surface_friction
                               : 0.5 * (model.bodies[first].surface_friction + model.bodies[second].surface_friction),
                         static_cast<std::int64_t>(e * edges_.size() + f) });
 }

@@ -1,15 +1,17 @@
 // Where other bodies touch a soft solid's surface (`type: volume`): every node of another body (a rope's,
 // a cloth's, another solid's) that is within its contact radius of a solid's boundary triangles, or behind
-// them; where two solids meet, every fold of one's boundary near or across a fold of the other's; and where
-// a solid meets a cloth's (or a jelly's) contact triangles, the solid's nodes over them and its folds across
-// their edges. implicit_euler holds each such pair apart inside its Newton solve (see its surface holds). A
-// scene with no solid, or with a solid and no other body, has no finder and pays nothing.
+// them; where two solids meet, every fold of one's boundary near or across a fold of the other's; where a
+// solid meets a cloth's (or a jelly's) contact triangles, the solid's nodes against them and its folds
+// across their edges; and its folds across a rope's (or a rod's) segments. implicit_euler holds each such
+// pair apart inside its Newton solve (see its surface holds). A scene with no solid, or with a solid and no
+// other body, has no finder and pays nothing.
 #pragma once
 
 #include <array>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
@@ -31,9 +33,9 @@ TrianglePoint nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, con
 /// - a node p of one body near or behind a boundary triangle of a solid: nodes (p, the triangle's three),
 ///   weights (1, -w_0, -w_1, -w_2), so g = x_p - q with q the triangle's point nearest to p at weights w;
 /// - a node p of a solid near a cloth's contact triangle: the same, the triangle the cloth's;
-/// - an edge (a, b) of one solid's boundary near or across an edge (c, d) of another's, or of a cloth's
-///   contact triangles: nodes (a, b, c, d), weights (1 - s, s, -(1 - t), -t), so g is the first edge's
-///   point minus the second's, s and t where the edges come closest.
+/// - an edge (a, b) of one solid's boundary near or across an edge (c, d) of another's, of a cloth's
+///   contact triangles or a rope's segment: nodes (a, b, c, d), weights (1 - s, s, -(1 - t), -t), so g is
+///   the first edge's point minus the second's, s and t where the edges come closest.
 /// n is the direction along which the first point is held out (from the triangle, or from the second
 /// edge), d = r - n . g its depth (> 0: closer than r, or behind). r is the node's contact radius (and the
 /// cloth triangle's thickness, its nodes' mean radius), or the sum of the two edges' nodes' mean radii.
@@ -84,10 +86,11 @@ public:
   /// those edges).
   ///
   /// A solid meets a cloth's (or a jelly's) contact triangles, two-sided sheets as thick as their nodes'
-  /// contact radii, with its nodes and its folds: a node over a triangle (its projection inside it) is held
-  /// on the side of the nearest such triangle it is on at x; a fold across an edge of the triangles, along
-  /// the common normal pointing into the solid. So a cloth draped over a soft box does not let the box's
-  /// rims and corners through between its nodes.
+  /// contact radii, with its nodes and its folds: a node against the nearest triangle, off its face on the
+  /// side it is on at x, or straight off its nearest edge or corner; a fold across an edge of the triangles,
+  /// along the common normal pointing into the solid. So a cloth draped over a soft box does not let the
+  /// box's rims and corners through between its nodes. Its folds meet a rope's (or a rod's) segments the
+  /// same way, at the rope's radius: a rope over a box's rim does not cut into it between its nodes.
   ///
   /// The depth is at the `predicted` positions (x + h v), d = r - n . g, and a pair is kept when
   /// d > -margin. Nodes and edges outside the other solid's bounding box now and predicted, widened by the
@@ -116,36 +119,45 @@ private:
     int a, b;
     int left, right;
   };
-  /// A body with contact triangles and no surface (a cloth, a jelly with face_contacts): its triangles are
-  /// Model::contact_triangles [first, end).
-  struct Sheet
+  /// A body without a surface that meets a solid by more than its nodes: a cloth's or a jelly's contact
+  /// triangles (Model::contact_triangles [first, end): two-sided sheets as thick as their nodes' contact
+  /// radii), or a rope's or a rod's segments (Model::contact_segments [first, end), of their nodes' radii).
+  struct Thin
   {
     std::size_t body;
+    bool triangles;
     std::size_t first, end;
   };
-  /// The edges of a surface (k < solids_.size(): solids_[k]'s boundary, else sheets_[k - solids_.size()]'s
-  /// triangles) in `edges_` that lie in the box [low, high] now or predicted.
+  /// The unit normals at positions x of the triangles on either side of `edge` of solid `body`'s boundary
+  /// (both the one triangle's on an open surface's rim).
+  static std::pair<Vec3, Vec3> sideNormals(const Model& model, const NodeArray& x, std::size_t body, const Edge& edge);
+  /// Whether `edge` of solid `body`'s boundary is a fold at positions x (kFold).
+  static bool isFold(const Model& model, const NodeArray& x, std::size_t body, const Edge& edge);
+  /// The edges of a surface (k < solids_.size(): solids_[k]'s boundary, else thin_[k - solids_.size()]'s
+  /// triangles' or segments) in `edges_` that lie in the box [low, high] now or predicted.
   void edgesIn(std::size_t k, const NodeArray& x, const NodeArray& predicted, const Vec3& low, const Vec3& high,
                std::vector<std::size_t>& found) const;
   /// Edges e and f (indices into edges_), e a solid's (Model::bodies `first`), f another solid's (`second`)
-  /// or, if `sheet`, a sheet's, into `touches` if they touch (find).
+  /// or, if `thin`, a thin body's, into `touches` if they touch (find).
   void touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t e,
-                  std::size_t f, std::size_t first, std::size_t second, bool sheet,
+                  std::size_t f, std::size_t first, std::size_t second, bool thin,
                   std::vector<SurfaceTouch>& touches) const;
-  /// solids_[i] against sheets_[k] (find): its nodes over the sheet's triangles, its folds across their
-  /// edges; [low, high] the sheet's box.
-  void touchSheet(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t i,
+  /// solids_[i] against thin_[k] (find): its nodes against the thin body's triangles, its folds across
+  /// their edges or its segments; [low, high] the thin body's box.
+  void touchThin(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t i,
                   std::size_t k, const Vec3& low, const Vec3& high, std::vector<SurfaceTouch>& touches);
 
   double widest_;                    ///< widestRadius()
   std::vector<std::size_t> solids_;  ///< bodies with a surface (Model::bodies), when another body exists
-  std::vector<Sheet> sheets_;        ///< bodies with contact triangles and no surface, when a solid exists
-  /// the edges of two or more solids' boundaries, and of the sheets' triangles if there is a solid, each once,
-  /// a surface's in a run (a sheet's edges have no triangles: left and right -1)
+  std::vector<Thin> thin_;           ///< the thin bodies, when a solid exists
+  /// the edges of two or more solids' boundaries, and of the thin bodies' triangles or segments if there is
+  /// a solid, each once, a body's in a run (a thin body's edges have no triangles: left and right -1)
   std::vector<Edge> edges_;
-  /// per surface (solids_, then sheets_), its first edge in edges_ (and one past the last)
+  /// per body (solids_, then thin_), its first edge in edges_ (and one past the last)
   std::vector<std::size_t> edges_first_;
-  std::vector<std::size_t> near_triangles_;  ///< touchSheet's triangles in the solid's box
+  std::vector<std::size_t> near_triangles_;  ///< touchThin's triangles in the solid's box
+  NodeArray outward_;                        ///< touchThin's outward directions of the solid's nodes
+  std::vector<bool> on_fold_;                ///< touchThin's: per node, on a fold of the solid
   std::vector<Vec3> low_, high_;     ///< find's boxes around the solids (per entry of solids_)
   std::vector<std::size_t> near_first_, near_second_;  ///< find's edges in the other solid's box
 };

@@ -199,8 +199,9 @@ void SurfaceHolds::find(const NewtonPoint& point, const ContactQuery* colliders)
     c.touch = touch;
     c.depth = c.scaled = 0.0;  // assemble sets them, and the block, each iteration
     c.block.setZero();
+    // A node of weight 0 (a segment's point fills the triangle's third place with it) takes no part.
     for (std::size_t l = 0; l < 4; ++l)
-      c.nodes[l] = model.isFree(touch.nodes[l]) ? touch.nodes[l] : -1;
+      c.nodes[l] = touch.weights[l] != 0.0 && model.isFree(touch.nodes[l]) ? touch.nodes[l] : -1;
     holds_.push_back(c);
   }
 }
