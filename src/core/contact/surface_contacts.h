@@ -2,7 +2,7 @@
 // a cloth's, another solid's) that is within its contact radius of a solid's boundary triangles, or behind
 // them; where two solids meet, every fold of one's boundary near or across a fold of the other's; where a
 // solid meets a cloth's (or a jelly's) contact triangles, the solid's nodes against them and its folds
-// across their edges; and its folds across a rope's (or a rod's) segments. implicit_euler holds each such
+// across their edges; and its rims' nodes and its folds against a rope's (or a rod's) segments. implicit_euler holds each such
 // pair apart inside its Newton solve (see its surface holds). A scene with no solid, or with a solid and no
 // other body, has no finder and pays nothing.
 #pragma once
@@ -90,7 +90,8 @@ public:
   /// side it is on at x, or straight off its nearest edge or corner; a fold across an edge of the triangles,
   /// along the common normal pointing into the solid. So a cloth draped over a soft box does not let the
   /// box's rims and corners through between its nodes. Its folds meet a rope's (or a rod's) segments the
-  /// same way, at the rope's radius: a rope over a box's rim does not cut into it between its nodes.
+  /// same way, at the rope's radius, and so do its nodes on a fold (the nearest segment's axis, a node
+  /// facing away from it skipped): a rope over a box's rim does not cut into it between its nodes.
   ///
   /// The depth is at the `predicted` positions (x + h v), d = r - n . g, and a pair is kept when
   /// d > -margin. Nodes and edges outside the other solid's bounding box now and predicted, widened by the
