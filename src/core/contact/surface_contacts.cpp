@@ -33,6 +33,21 @@ std::pair<Vec3, Vec3> bodyBox(const BodyRange& body, const NodeArray& x, const N
   }
   return { low.array() - widen, high.array() + widen };
 }
+
+/// Of the touches from `first` on (one edge's against another body's), only the kEdgeTouches deepest: an
+/// edge holds on a few others (a rope bent over a rim touches it with two segments), as a node on its
+/// nearest triangle. In the tangle a long step leaves, every pair of near edges would hold, and the solve
+/// would take all their couplings (seen: 4876 pairs in a cloth over a cube that had diverged).
+void keepDeepest(std::vector<SurfaceTouch>& touches, std::size_t first)
+{
+  constexpr std::size_t kEdgeTouches = 2;
+  if (touches.size() <= first + kEdgeTouches)
+    return;
+  const auto from = touches.begin() + static_cast<std::ptrdiff_t>(first);
+  std::partial_sort(from, from + kEdgeTouches, touches.end(),
+                    [](const SurfaceTouch& a, const SurfaceTouch& b) { return a.depth > b.depth; });
+  touches.erase(from + static_cast<std::ptrdiff_t>(kEdgeTouches), touches.end());
+}
 }  // namespace
 
 TrianglePoint nearestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
@@ -226,8 +241,12 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
         continue;
       edgesIn(j, x, predicted, low_[i], high_[i], near_second_);
       for (const std::size_t e : near_first_)
+      {
+        const std::size_t before = touches.size();
         for (const std::size_t f : near_second_)
           touchEdges(model, x, predicted, margin, e, f, solids_[i], solids_[j], false, touches);
+        keepDeepest(touches, before);
+      }
     }
   // A solid against a thin body in its box.
   for (std::size_t k = 0; k < thin_.size(); ++k)
@@ -354,8 +373,12 @@ void SurfaceContacts::touchThin(const Model& model, const NodeArray& x, const No
   // Its folds across the triangles' edges or the segments.
   edgesIn(i, x, predicted, low, high, near_first_);
   for (const std::size_t e : near_first_)
+  {
+    const std::size_t before = touches.size();
     for (const std::size_t f : near_second_)
       touchEdges(model, x, predicted, margin, e, f, solids_[i], thin.body, true, touches);
+    keepDeepest(touches, before);
+  }
 }
 
 std::pair<Vec3, Vec3> SurfaceContacts::sideNormals(const Model& model, const NodeArray& x, std::size_t body,
