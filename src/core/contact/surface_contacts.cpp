@@ -240,13 +240,7 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
       if (near_first_.empty())
         continue;
       edgesIn(j, x, predicted, low_[i], high_[i], near_second_);
-      for (const std::size_t e : near_first_)
-      {
-        const std::size_t before = touches.size();
-        for (const std::size_t f : near_second_)
-          touchEdges(model, x, predicted, margin, e, f, solids_[i], solids_[j], false, touches);
-        keepDeepest(touches, before);
-      }
+      touchNearEdges(model, x, predicted, margin, solids_[i], solids_[j], false, touches);
     }
   // A solid against a thin body in its box.
   for (std::size_t k = 0; k < thin_.size(); ++k)
@@ -326,7 +320,7 @@ void SurfaceContacts::touchThin(const Model& model, const NodeArray& x, const No
     }
     for (std::size_t n = 0; !thin.triangles && n < near_second_.size(); ++n)
     {
-      const Edge& segment = edges_[near_second_[n]];
+      const Edge& segment = edges_[near_second_[n].edge];
       const Vec3 c = x.col(segment.a), along = x.col(segment.b) - c;
       const double t = closestSegmentParameters(at, Vec3::Zero(), c, along).second;
       const double distance = (at - c - t * along).squaredNorm();
@@ -372,13 +366,7 @@ void SurfaceContacts::touchThin(const Model& model, const NodeArray& x, const No
   }
   // Its folds across the triangles' edges or the segments.
   edgesIn(i, x, predicted, low, high, near_first_);
-  for (const std::size_t e : near_first_)
-  {
-    const std::size_t before = touches.size();
-    for (const std::size_t f : near_second_)
-      touchEdges(model, x, predicted, margin, e, f, solids_[i], thin.body, true, touches);
-    keepDeepest(touches, before);
-  }
+  touchNearEdges(model, x, predicted, margin, solids_[i], thin.body, true, touches);
 }
 
 std::pair<Vec3, Vec3> SurfaceContacts::sideNormals(const Model& model, const NodeArray& x, std::size_t body,
@@ -402,14 +390,33 @@ bool SurfaceContacts::isFold(const Model& model, const NodeArray& x, std::size_t
 }
 
 void SurfaceContacts::edgesIn(std::size_t k, const NodeArray& x, const NodeArray& predicted, const Vec3& low,
-                              const Vec3& high, std::vector<std::size_t>& found) const
+                              const Vec3& high, std::vector<NearEdge>& found) const
 {
   found.clear();
   for (std::size_t e = edges_first_[k]; e < edges_first_[k + 1]; ++e)
   {
     const auto [least, most] = sweptBox(edges_[e].a, edges_[e].b, x, predicted);
     if ((most.array() >= low.array()).all() && (least.array() <= high.array()).all())
-      found.push_back(e);
+      found.push_back({ e, least, most, (x.col(edges_[e].b) - x.col(edges_[e].a)).norm() });
+  }
+}
+
+void SurfaceContacts::touchNearEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
+                                     std::size_t first, std::size_t second, bool thin,
+                                     std::vector<SurfaceTouch>& touches) const
+{
+  for (const NearEdge& e : near_first_)
+  {
+    const std::size_t before = touches.size();
+    for (const NearEdge& f : near_second_)
+    {
+      // Boxes farther apart than any pair's reach in touchEdges (two widest radii, the margin, the deepest
+      // crossing) cannot touch: most pairs are left here without their nearest points.
+      const double reach = 2.0 * widest_ + margin + kDeepestCrossing * std::min(e.length, f.length);
+      if ((e.most.array() + reach >= f.least.array()).all() && (f.most.array() + reach >= e.least.array()).all())
+        touchEdges(model, x, predicted, margin, e.edge, f.edge, first, second, thin, touches);
+    }
+    keepDeepest(touches, before);
   }
 }
 

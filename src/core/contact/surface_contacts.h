@@ -136,8 +136,19 @@ private:
   static bool isFold(const Model& model, const NodeArray& x, std::size_t body, const Edge& edge);
   /// The edges of a surface (k < solids_.size(): solids_[k]'s boundary, else thin_[k - solids_.size()]'s
   /// triangles' or segments) in `edges_` that lie in the box [low, high] now or predicted.
+  /// An edge in another body's box: its index in edges_, its box now and predicted, its length now [m].
+  struct NearEdge
+  {
+    std::size_t edge;
+    Vec3 least, most;
+    double length;
+  };
   void edgesIn(std::size_t k, const NodeArray& x, const NodeArray& predicted, const Vec3& low, const Vec3& high,
-               std::vector<std::size_t>& found) const;
+               std::vector<NearEdge>& found) const;
+  /// Every edge of near_first_ (Model::bodies `first`'s, a solid's) against every edge of near_second_
+  /// (`second`'s; `thin` as touchEdges) whose boxes come near enough, each keeping its deepest touches.
+  void touchNearEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
+                      std::size_t first, std::size_t second, bool thin, std::vector<SurfaceTouch>& touches) const;
   /// Edges e and f (indices into edges_), e a solid's (Model::bodies `first`), f another solid's (`second`)
   /// or, if `thin`, a thin body's, into `touches` if they touch (find).
   void touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t e,
@@ -160,7 +171,7 @@ private:
   NodeArray outward_;                        ///< touchThin's outward directions of the solid's nodes
   std::vector<bool> on_fold_;                ///< touchThin's: per node, on a fold of the solid
   std::vector<Vec3> low_, high_;     ///< find's boxes around the solids (per entry of solids_)
-  std::vector<std::size_t> near_first_, near_second_;  ///< find's edges in the other solid's box
+  std::vector<NearEdge> near_first_, near_second_;  ///< find's edges in the other body's box
 };
 
 }  // namespace soft_body_sim
