@@ -88,6 +88,29 @@ double signedDistance(const BodyRange& solid, const NodeArray& x, const Vec3& p)
   return solid_angle > 2.0 * M_PI ? -nearest : nearest;
 }
 
+/// The edges of `triangles`, each once (its lower node first).
+std::vector<std::pair<int, int>> uniqueEdges(const std::vector<std::array<int, 3>>& triangles)
+{
+  std::vector<std::pair<int, int>> edges;
+  for (const std::array<int, 3>& t : triangles)
+    for (int k = 0; k < 3; ++k)
+      edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  return edges;
+}
+
+/// The nearest that any point of the line of nodes `line` (a rope's axis: its nodes and 15 points between
+/// each two) comes to the surface of `solid` at positions x [m] (signedDistance: < 0 inside).
+double nearestAxisPoint(const BodyRange& solid, const BodyRange& line, const NodeArray& x)
+{
+  double nearest = INFINITY;
+  for (int i = line.first; i + 1 < line.first + line.count; ++i)
+    for (int k = 0; k <= 16; ++k)
+      nearest = std::min(nearest, signedDistance(solid, x, x.col(i) + (x.col(i + 1) - x.col(i)) * (k / 16.0)));
+  return nearest;
+}
+
 /// How deep the deepest point of `a`'s boundary edges lies inside the solid `b` at positions x [m] (< 0:
 /// none is inside): each edge's ends and 15 points between, those inside b's bounding box judged by
 /// signedDistance. Two closed surfaces cross only where an edge of one passes through the other.
@@ -99,12 +122,7 @@ double deepestEdgePoint(const BodyRange& a, const BodyRange& b, const NodeArray&
     low = low.cwiseMin(x.col(i));
     high = high.cwiseMax(x.col(i));
   }
-  std::vector<std::pair<int, int>> edges;
-  for (const std::array<int, 3>& t : a.surface)
-    for (int k = 0; k < 3; ++k)
-      edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
-  std::sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  const std::vector<std::pair<int, int>> edges = uniqueEdges(a.surface);
   double deepest = -INFINITY;
   const int points = 16;
   for (const auto& [i, j] : edges)
@@ -340,18 +358,8 @@ TEST(SurfaceContacts, AClothDrapedOverACubeKeepsItsThicknessFromTheCubesRimsAndC
     World world = buildWorld(scene);
     const Model& model = world.model();
     const BodyRange& solid = model.bodies[0];
-    std::vector<std::pair<int, int>> cube_edges, cloth_edges;
-    for (const std::array<int, 3>& t : solid.surface)
-      for (int k = 0; k < 3; ++k)
-        cube_edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
-    for (const std::array<int, 3>& t : model.contact_triangles)
-      for (int k = 0; k < 3; ++k)
-        cloth_edges.emplace_back(std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3]));
-    for (auto* edges : { &cube_edges, &cloth_edges })
-    {
-      std::sort(edges->begin(), edges->end());
-      edges->erase(std::unique(edges->begin(), edges->end()), edges->end());
-    }
+    const std::vector<std::pair<int, int>> cube_edges = uniqueEdges(solid.surface);
+    const std::vector<std::pair<int, int>> cloth_edges = uniqueEdges(model.contact_triangles);
     const int points = 16;
     // The nearest distance between the cube's edges and the cloth's triangles, and between the cloth's
     // edges and the cube's surface (negative where a cloth point is inside the cube).
@@ -418,14 +426,7 @@ TEST(SurfaceContacts, ARopeDroppedAcrossACubeRestsOnItsTopAndNeverEntersIt)
       World world = buildWorld(scene);
       const BodyRange& solid = world.model().bodies[0];
       const BodyRange& line = world.model().bodies[1];
-      const auto closest = [&]() {
-        const NodeArray& x = world.state().position;
-        double nearest = INFINITY;
-        for (int i = line.first; i + 1 < line.first + line.count; ++i)
-          for (int k = 0; k <= 16; ++k)
-            nearest = std::min(nearest, signedDistance(solid, x, x.col(i) + (x.col(i + 1) - x.col(i)) * (k / 16.0)));
-        return nearest;
-      };
+      const auto closest = [&]() { return nearestAxisPoint(solid, line, world.state().position); };
       const std::string at = "y " + std::to_string(c.y) + ", dt " + std::to_string(dt);
       double landing = INFINITY;
       for (int step = 0; step < static_cast<int>(std::lround(10.0 / dt)); ++step)
@@ -492,15 +493,7 @@ TEST(SurfaceContacts, ARopeRestsOnAPinnedBlockWhoseFreeNodesFormChains)
       const BodyRange& line = world.model().bodies[1];
       const std::string at = std::string(two_free ? "two free nodes" : "pinned") + ", dt " + std::to_string(dt);
       const auto distance = [&](int i) { return signedDistance(solid, world.state().position, world.state().position.col(i)); };
-      // The nearest point of the rope's axis (its nodes and 15 points between each two).
-      const auto closest = [&]() {
-        const NodeArray& x = world.state().position;
-        double nearest = INFINITY;
-        for (int i = line.first; i + 1 < line.first + line.count; ++i)
-          for (int k = 0; k <= 16; ++k)
-            nearest = std::min(nearest, signedDistance(solid, x, x.col(i) + (x.col(i + 1) - x.col(i)) * (k / 16.0)));
-        return nearest;
-      };
+      const auto closest = [&]() { return nearestAxisPoint(solid, line, world.state().position); };
       double landing = INFINITY;
       for (int step = 0; step < static_cast<int>(std::lround(5.0 / dt)); ++step)
       {

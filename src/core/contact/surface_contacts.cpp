@@ -13,6 +13,12 @@ namespace soft_body_sim
 {
 namespace
 {
+/// Whether `at` lies in the box [low, high].
+bool inBox(const Vec3& at, const Vec3& low, const Vec3& high)
+{
+  return (at.array() >= low.array()).all() && (at.array() <= high.array()).all();
+}
+
 /// The box (least, most) around an edge of nodes a and b, now (x) and predicted.
 std::pair<Vec3, Vec3> sweptBox(int a, int b, const NodeArray& x, const NodeArray& predicted)
 {
@@ -98,26 +104,22 @@ SurfaceContacts::SurfaceContacts(const Model& model)
       solids_.push_back(b);
   if (solids_.empty())
     return;
-  for (std::size_t t = 0; t < model.contact_triangles.size();)
-  {
-    const std::size_t body = model.bodyOf(model.contact_triangles[t][0]);
-    std::size_t end = t + 1;
-    while (end < model.contact_triangles.size() && model.bodyOf(model.contact_triangles[end][0]) == body)
-      ++end;
-    if (model.bodies[body].surface.empty())
-      thin_.push_back({ body, true, t, end });
-    t = end;
-  }
-  for (std::size_t s = 0; s < model.contact_segments.size();)
-  {
-    const std::size_t body = model.bodyOf(model.contact_segments[s].first);
-    std::size_t end = s + 1;
-    while (end < model.contact_segments.size() && model.bodyOf(model.contact_segments[end].first) == body)
-      ++end;
-    if (model.bodies[body].surface.empty())
-      thin_.push_back({ body, false, s, end });
-    s = end;
-  }
+  // Each body's run of contact triangles, then of segments (a body's are consecutive), of the bodies with
+  // no surface.
+  const auto addRuns = [&](std::size_t count, const auto& first_node, bool triangles) {
+    for (std::size_t t = 0; t < count;)
+    {
+      const std::size_t body = model.bodyOf(first_node(t));
+      std::size_t end = t + 1;
+      while (end < count && model.bodyOf(first_node(end)) == body)
+        ++end;
+      if (model.bodies[body].surface.empty())
+        thin_.push_back({ body, triangles, t, end });
+      t = end;
+    }
+  };
+  addRuns(model.contact_triangles.size(), [&](std::size_t t) { return model.contact_triangles[t][0]; }, true);
+  addRuns(model.contact_segments.size(), [&](std::size_t s) { return model.contact_segments[s].first; }, false);
   if (solids_.size() < 2 && thin_.empty())
     return;  // no edges meet
   // Each body's edges, each once, with a solid's triangles on either side.
@@ -161,9 +163,6 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
                            std::vector<SurfaceTouch>& touches)
 {
   touches.clear();
-  const auto inside = [](const Vec3& at, const Vec3& low, const Vec3& high) {
-    return (at.array() >= low.array()).all() && (at.array() <= high.array()).all();
-  };
   // The box around each solid now and where it is predicted, widened by the widest radius and the margin.
   low_.resize(solids_.size());
   high_.resize(solids_.size());
@@ -188,7 +187,7 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
       for (int p = body.first; p < body.first + body.count; ++p)
       {
         const Vec3 at = x.col(p);
-        if (!inside(at, low, high) && !inside(predicted.col(p), low, high))
+        if (!inBox(at, low, high) && !inBox(predicted.col(p), low, high))
           continue;
         double nearest = std::numeric_limits<double>::infinity();
         const std::array<int, 3>* face = nullptr;
@@ -297,10 +296,8 @@ void SurfaceContacts::touchThin(const Model& model, const NodeArray& x, const No
   for (int p = solid.first; p < solid.first + solid.count; ++p)
   {
     const Vec3 at = x.col(p);
-    const auto in = [&](const Vec3& point) {
-      return (point.array() >= low.array()).all() && (point.array() <= high.array()).all();
-    };
-    if ((!in(at) && !in(predicted.col(p))) || (!thin.triangles && !on_fold_[static_cast<std::size_t>(p)]))
+    if ((!inBox(at, low, high) && !inBox(predicted.col(p), low, high)) ||
+        (!thin.triangles && !on_fold_[static_cast<std::size_t>(p)]))
       continue;
     double nearest = std::numeric_limits<double>::infinity();
     std::array<int, 3> corners{};
@@ -409,34 +406,27 @@ void SurfaceContacts::touchNearEdges(const Model& model, const NodeArray& x, con
   {
     const std::size_t before = touches.size();
     for (const NearEdge& f : near_second_)
-    {
-      // Boxes farther apart than any pair's reach in touchEdges (two widest radii, the margin, the deepest
-      // crossing) cannot touch: most pairs are left here without their nearest points.
-      const double reach = 2.0 * widest_ + margin + kDeepestCrossing * std::min(e.length, f.length);
-      if ((e.most.array() + reach >= f.least.array()).all() && (f.most.array() + reach >= e.least.array()).all())
-        touchEdges(model, x, predicted, margin, e.edge, f.edge, first, second, thin, touches);
-    }
+      touchEdges(model, x, predicted, margin, e, f, first, second, thin, touches);
     keepDeepest(touches, before);
   }
 }
 
 void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
-                                 std::size_t e, std::size_t f, std::size_t first, std::size_t second, bool thin,
-                                 std::vector<SurfaceTouch>& touches) const
+                                 const NearEdge& e, const NearEdge& f, std::size_t first, std::size_t second,
+                                 bool thin, std::vector<SurfaceTouch>& touches) const
 {
-  const Edge& one = edges_[e];
-  const Edge& two = edges_[f];
+  const Edge& one = edges_[e.edge];
+  const Edge& two = edges_[f.edge];
   const double radius = 0.5 * (model.contact_radius[one.a] + model.contact_radius[one.b]) +
                         0.5 * (model.contact_radius[two.a] + model.contact_radius[two.b]);
+  const double deepest = kDeepestCrossing * std::min(e.length, f.length);
+  // Their boxes, now and predicted, within the radius, the margin and the deepest crossing of each other:
+  // most pairs are left here without their nearest points.
+  const double reach = radius + margin + deepest;
+  if (!((e.most.array() + reach >= f.least.array()).all() && (f.most.array() + reach >= e.least.array()).all()))
+    return;
   const Vec3 a = x.col(one.a), along_one = x.col(one.b) - a;
   const Vec3 c = x.col(two.a), along_two = x.col(two.b) - c;
-  const double deepest = kDeepestCrossing * std::sqrt(std::min(along_one.squaredNorm(), along_two.squaredNorm()));
-  // Their boxes, now and predicted, within the radius, the margin and the deepest crossing of each other.
-  const double reach = radius + margin + deepest;
-  const auto [least_one, most_one] = sweptBox(one.a, one.b, x, predicted);
-  const auto [least_two, most_two] = sweptBox(two.a, two.b, x, predicted);
-  if (!((most_one.array() + reach >= least_two.array()).all() && (most_two.array() + reach >= least_one.array()).all()))
-    return;
   const auto [s, t] = closestSegmentParameters(a, along_one, c, along_two, kNearParallelSine2);
   if (!(s > kEdgeEnd && s < 1.0 - kEdgeEnd && t > kEdgeEnd && t < 1.0 - kEdgeEnd))
     return;  // nearest at an end, or near parallel: that node and the other's faces
@@ -472,7 +462,7 @@ void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const N
     touches.push_back({ nodes, weights, normal, predicted_gap, depth,
                         thin ? model.bodies[first].surface_friction
                               : 0.5 * (model.bodies[first].surface_friction + model.bodies[second].surface_friction),
-                        static_cast<std::int64_t>(e * edges_.size() + f) });
+                        static_cast<std::int64_t>(e.edge * edges_.size() + f.edge) });
 }
 
 }  // namespace soft_body_sim

@@ -2,9 +2,9 @@
 // a cloth's, another solid's) that is within its contact radius of a solid's boundary triangles, or behind
 // them; where two solids meet, every fold of one's boundary near or across a fold of the other's; where a
 // solid meets a cloth's (or a jelly's) contact triangles, the solid's nodes against them and its folds
-// across their edges; and its rims' nodes and its folds against a rope's (or a rod's) segments. implicit_euler holds each such
-// pair apart inside its Newton solve (see its surface holds). A scene with no solid, or with a solid and no
-// other body, has no finder and pays nothing.
+// across their edges; and its rims' nodes and its folds against a rope's (or a rod's) segments.
+// implicit_euler holds each such pair apart inside its Newton solve (see its surface holds). A scene with
+// no solid, or with a solid and no other body, has no finder and pays nothing.
 #pragma once
 
 #include <array>
@@ -149,10 +149,10 @@ private:
   /// (`second`'s; `thin` as touchEdges) whose boxes come near enough, each keeping its deepest touches.
   void touchNearEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
                       std::size_t first, std::size_t second, bool thin, std::vector<SurfaceTouch>& touches) const;
-  /// Edges e and f (indices into edges_), e a solid's (Model::bodies `first`), f another solid's (`second`)
-  /// or, if `thin`, a thin body's, into `touches` if they touch (find).
-  void touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin, std::size_t e,
-                  std::size_t f, std::size_t first, std::size_t second, bool thin,
+  /// Edges e and f, e a solid's (Model::bodies `first`), f another solid's (`second`) or, if `thin`, a thin
+  /// body's, into `touches` if they touch (find).
+  void touchEdges(const Model& model, const NodeArray& x, const NodeArray& predicted, double margin,
+                  const NearEdge& e, const NearEdge& f, std::size_t first, std::size_t second, bool thin,
                   std::vector<SurfaceTouch>& touches) const;
   /// solids_[i] against thin_[k] (find): its nodes against the thin body's triangles, its folds across
   /// their edges or its segments; [low, high] the thin body's box.
