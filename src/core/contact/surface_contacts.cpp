@@ -229,6 +229,11 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
   }
   if (edges_.empty())
     return;
+  // Which of the solids' edges are folds: only those touch another body's edges.
+  fold_.resize(edges_first_[solids_.size()]);
+  for (std::size_t i = 0; i < solids_.size(); ++i)
+    for (std::size_t e = edges_first_[i]; e < edges_first_[i + 1]; ++e)
+      fold_[e] = finite(i) && isFold(model, x, solids_[i], edges_[e]);
   // Two solids' edges, those of each in the other's box.
   for (std::size_t i = 0; i < solids_.size(); ++i)
     for (std::size_t j = i + 1; j < solids_.size(); ++j)
@@ -288,7 +293,7 @@ void SurfaceContacts::touchThin(const Model& model, const NodeArray& x, const No
         outward_.col(node) += normal;
     }
     for (std::size_t e = edges_first_[i]; e < edges_first_[i + 1]; ++e)
-      if (isFold(model, x, solids_[i], edges_[e]))
+      if (fold_[e])
         on_fold_[static_cast<std::size_t>(edges_[e].a)] = on_fold_[static_cast<std::size_t>(edges_[e].b)] = true;
   }
   // Its nodes, each against the nearest triangle or segment: pushed off a triangle's face on the side it is
@@ -392,6 +397,8 @@ void SurfaceContacts::edgesIn(std::size_t k, const NodeArray& x, const NodeArray
   found.clear();
   for (std::size_t e = edges_first_[k]; e < edges_first_[k + 1]; ++e)
   {
+    if (k < solids_.size() && !fold_[e])
+      continue;
     const auto [least, most] = sweptBox(edges_[e].a, edges_[e].b, x, predicted);
     if ((most.array() >= low.array()).all() && (least.array() <= high.array()).all())
       found.push_back({ e, least, most, (x.col(edges_[e].b) - x.col(edges_[e].a)).norm() });
@@ -433,17 +440,13 @@ void SurfaceContacts::touchEdges(const Model& model, const NodeArray& x, const N
   const Vec3 across = along_one.cross(along_two);
   if (!(across.squaredNorm() > kNearParallelSine2 * along_one.squaredNorm() * along_two.squaredNorm()))
     return;
-  // Each solid edge's outward direction (its triangles' normals summed); both must be folds (a thin body's
-  // edge has no side: the solid's says which way n points).
-  bool folds = true;
+  // Each solid edge's outward direction (its triangles' normals summed; a thin body's edge has no side: the
+  // solid's says which way n points).
   const auto outward = [&](const Edge& edge, std::size_t body) {
-    folds = folds && isFold(model, x, body, edge);
     const auto [left, right] = sideNormals(model, x, body, edge);
     return edge.right < 0 ? left : Vec3(left + right);
   };
   const Vec3 out_one = outward(one, first), out_two = thin ? -out_one : outward(two, second);
-  if (!folds)
-    return;  // an edge inside a flat face: the other's nodes meet that face
   Vec3 normal = across.normalized();
   if (normal.dot(out_two - out_one) < 0.0)
     normal = -normal;

@@ -134,7 +134,7 @@ private:
   static std::pair<Vec3, Vec3> sideNormals(const Model& model, const NodeArray& x, std::size_t body, const Edge& edge);
   /// Whether `edge` of solid `body`'s boundary is a fold at positions x (kFold).
   static bool isFold(const Model& model, const NodeArray& x, std::size_t body, const Edge& edge);
-  /// The edges of a surface (k < solids_.size(): solids_[k]'s boundary, else thin_[k - solids_.size()]'s
+  /// The edges of a surface (k < solids_.size(): solids_[k]'s boundary folds, else thin_[k - solids_.size()]'s
   /// triangles' or segments) in `edges_` that lie in the box [low, high] now or predicted.
   /// An edge in another body's box: its index in edges_, its box now and predicted, its length now [m].
   struct NearEdge
@@ -167,6 +167,9 @@ private:
   std::vector<Edge> edges_;
   /// per body (solids_, then thin_), its first edge in edges_ (and one past the last)
   std::vector<std::size_t> edges_first_;
+  /// per solid edge (edges_ before edges_first_[solids_.size()]), whether it is a fold at find's x (an
+  /// edge inside a flat face meets no edge: the other body's nodes meet that face)
+  std::vector<bool> fold_;
   std::vector<std::size_t> near_triangles_;  ///< touchThin's triangles in the solid's box
   NodeArray outward_;                        ///< touchThin's outward directions of the solid's nodes
   std::vector<bool> on_fold_;                ///< touchThin's: per node, on a fold of the solid
