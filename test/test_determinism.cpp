@@ -49,7 +49,7 @@ const std::vector<Pinned> kPinned = {
   { "config/scenes/creature.yaml", "rk4", 0x4aa0ff5b90f3abafULL },
   { "config/scenes/creature.yaml", "implicit_euler", 0xe7adc476ec781decULL },
   { "config/scenes/creature.yaml", "xpbd", 0x4cc3d2920fde0bf4ULL },
-  { "config/scenes/demo.yaml", "implicit_euler", 0x283dff2123efe542ULL },
+  { "config/scenes/demo.yaml", "implicit_euler", 0xe4a566c3c6a51dadULL },
   { "config/scenes/demo.yaml", "xpbd", 0x6705e09ca5659157ULL },
   { "config/scenes/hanging_chain.yaml", "implicit_euler", 0x114803029f29833cULL },
   { "config/scenes/hanging_chain.yaml", "xpbd", 0xa88ae03d24c4615eULL },

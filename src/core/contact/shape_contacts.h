@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <optional>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "core/contact/closest_points.h"
@@ -225,6 +227,90 @@ public:
       found = true;
     }
     return found;
+  }
+
+  void appendFaceContacts(const Model& model, const NodeArray& start, const NodeArray& end, double h, double margin,
+                          int first, std::vector<FaceContact>& found) const override
+  {
+    if (model.contact_triangles.empty())
+      return;
+    // The features where the shapes are (the sub-step's start) and where their velocities take them by its
+    // end, and each shape's box over both, as the contact stage has them (boxTriangles, placeGroups).
+    placeFeatures(query_start_);
+    query_end_.resize(shapes_.size());
+    query_groups_.resize(shapes_.size());
+    query_boxes_.resize(shapes_.size());
+    const double widest = model.contact_radius.maxCoeff();
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      const auto [position, orientation] = advanced(shapes_[k].at, h);
+      query_end_[k].clear();
+      query_boxes_[k].setEmpty();
+      for (std::size_t f = 0; f < features_[k].size(); ++f)
+      {
+        const ShapeFeature& local = features_[k][f];
+        query_end_[k].push_back({ position + orientation * local.a, position + orientation * local.b, local.radius,
+                                  local.flat_ends });
+        const double reach = local.radius + widest + margin;
+        for (const ShapeFeature* feature : { &query_end_[k][f], &query_start_[k][f] })
+          for (const Vec3& point : { feature->a, feature->b })
+          {
+            query_boxes_[k].extend(Vec3(point.array() - reach));
+            query_boxes_[k].extend(Vec3(point.array() + reach));
+          }
+      }
+      query_groups_[k].clear();
+      for (const FeatureGroup& group : groups_[k])
+        query_groups_[k].emplace_back(position + orientation * group.centre,
+                                      shapes_[k].at.position + shapes_[k].at.orientation * group.centre);
+    }
+    for (std::size_t t = 0; t < model.contact_triangles.size(); ++t)
+    {
+      const std::array<int, 3>& triangle = model.contact_triangles[t];
+      const TriangleCorners then{ start.col(triangle[0]), start.col(triangle[1]), start.col(triangle[2]) };
+      const TriangleCorners now{ end.col(triangle[0]), end.col(triangle[1]), end.col(triangle[2]) };
+      const double thickness = triangleThickness(model, triangle);
+      Eigen::AlignedBox3d box;
+      for (int c = 0; c < 3; ++c)
+      {
+        box.extend(then[c]);
+        box.extend(now[c]);
+      }
+      box.min().array() -= thickness;
+      box.max().array() += thickness;
+      std::optional<TriangleBall> ball;
+      for (std::size_t k = 0; k < shapes_.size(); ++k)
+      {
+        if (!placed_[k] || features_[k].empty() || !box.intersects(query_boxes_[k]))
+          continue;
+        if (!ball)
+          ball.emplace(now, then);
+        const ColliderPlacement& at = shapes_[k].at;
+        const Vec3 centre_end = at.position + h * at.velocity;
+        for (std::size_t g = 0; g < groups_[k].size(); ++g)
+        {
+          const FeatureGroup& group = groups_[k][g];
+          if (!ball->meets(query_groups_[k][g].first, query_groups_[k][g].second, group.radius + thickness + margin))
+            continue;
+          for (std::size_t f = group.first; f < group.last; ++f)
+          {
+            if (!ball->meetsSegment(query_end_[k][f], query_start_[k][f], thickness + margin))
+              continue;
+            // Within the margin: the thicknesses widened by it, the depth taken back.
+            const std::optional<FaceTouch> touch = faceTouch(query_end_[k][f], query_start_[k][f], now, then,
+                                                             thickness + margin, kFaceSag * thickness + margin);
+            // A corner is its node's contact (`touching`).
+            if (!touch || touch->weight.maxCoeff() >= 1.0)
+              continue;
+            const Vec3 velocity = at.velocity + at.angular_velocity.cross(touch->contact - centre_end);
+            found.push_back({ t, touch->weight,
+                              NodeContact{ touch->normal, velocity, at.friction, touch->depth - margin,
+                                           first + static_cast<int>(k) },
+                              f });
+          }
+        }
+      }
+    }
   }
 
   std::size_t count() const override { return shapes_.size(); }
@@ -598,18 +684,21 @@ private:
     received_[shape].add(point - shapes_[shape].at.position, impulse);
   }
 
+  /// Where a shape placed `at` is after h [s] at its constant velocity and angular velocity.
+  static std::pair<Vec3, Eigen::Quaterniond> advanced(const ColliderPlacement& at, double h)
+  {
+    const double angle = at.angular_velocity.norm() * h;
+    if (!(angle > 0.0))
+      return { at.position + h * at.velocity, at.orientation };
+    return { at.position + h * at.velocity,
+             (Eigen::Quaterniond(Eigen::AngleAxisd(angle, at.angular_velocity.normalized())) * at.orientation).normalized() };
+  }
+
   /// Every shape moves by its constant velocity and turns by its angular velocity over h.
   void move(double h)
   {
     for (Shape& shape : shapes_)
-    {
-      ColliderPlacement& at = shape.at;
-      at.position += h * at.velocity;
-      const double angle = at.angular_velocity.norm() * h;
-      if (angle > 0.0)
-        at.orientation = (Eigen::Quaterniond(Eigen::AngleAxisd(angle, at.angular_velocity.normalized())) *
-                          at.orientation).normalized();
-    }
+      std::tie(shape.at.position, shape.at.orientation) = advanced(shape.at, h);
   }
 
   std::vector<Shape> shapes_;
@@ -628,6 +717,11 @@ private:
   std::vector<Vec3> start_positions_;  ///< per shape: its origin at the start of the current sub-step [m]
   std::vector<Eigen::Quaterniond> start_orientations_;  ///< per shape: its orientation then
   std::vector<ReceivedImpulse> received_;  ///< per shape: from the bodies since the step began
+  /// appendFaceContacts' features at the sub-step's start and end, its feature groups' centres (end,
+  /// start) and its shapes' boxes over both
+  mutable std::vector<std::vector<ShapeFeature>> query_start_, query_end_;
+  mutable std::vector<std::vector<std::pair<Vec3, Vec3>>> query_groups_;
+  mutable std::vector<Eigen::AlignedBox3d> query_boxes_;
 };
 
 }  // namespace soft_body_sim

@@ -104,6 +104,13 @@ public:
   {
     return false;
   }
+  /// ContactQuery::touchingFaces over its shapes (as they are before this sub-step's resolve moves them),
+  /// appended to `found`; each contact's `collider` is its shape's index among its own plus `first`.
+  virtual void appendFaceContacts(const Model& /*model*/, const NodeArray& /*start*/, const NodeArray& /*end*/,
+                                  double /*h*/, double /*margin*/, int /*first*/,
+                                  std::vector<FaceContact>& /*found*/) const
+  {
+  }
   /// How many shapes it has (ContactStage numbers every kind's shapes in turn).
   virtual std::size_t count() const = 0;
   /// Its shape `shape` received `impulse` [N s] at `point` [m] from a solve (ContactQuery::receive).
@@ -158,6 +165,14 @@ public:
         found = true;
       }
     return found;
+  }
+
+  void touchingFaces(const Model& model, const NodeArray& start, const NodeArray& end, double h, double margin,
+                     std::vector<FaceContact>& found) const override
+  {
+    found.clear();
+    for (std::size_t k = 0; k < kinds_.size(); ++k)
+      kinds_[k]->appendFaceContacts(model, start, end, h, margin, static_cast<int>(first_[k]), found);
   }
 
   void receive(const NodeContact& contact, const Vec3& point, const Vec3& impulse) override

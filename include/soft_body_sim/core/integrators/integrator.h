@@ -39,6 +39,18 @@ struct NodeContact
   int collider = -1;      ///< which collider it is, for ContactQuery::receive (-1: none)
 };
 
+/// A point of a contact triangle that a collider's edge, corner or thin part comes near between the
+/// triangle's nodes (face contacts; ContactQuery::touchingFaces).
+struct FaceContact
+{
+  std::size_t triangle = 0;  ///< its index in Model::contact_triangles
+  Vec3 weight;               ///< the point sum_k weight_k x_k of the triangle's corners
+  /// normal: the way the point leaves the shape; velocity: the shape's at the contact; depth [m]: how far
+  /// the point is inside the triangle's thickness from the shape at the sub-step's end (< 0: outside)
+  NodeContact contact;
+  std::size_t feature = 0;  ///< which of the collider's features (with the triangle and the collider, the contact's name)
+};
+
 /// The colliders as a solve can ask about them (the contact stage, contact_stage.h).
 class ContactQuery
 {
@@ -50,6 +62,15 @@ public:
   /// A solve that took `contact` into itself gave its node a contact impulse: the collider receives the
   /// opposite, `impulse` [N s], at `point` [m] (World::colliderWrenches).
   virtual void receive(const NodeContact& contact, const Vec3& point, const Vec3& impulse) = 0;
+  /// Where the contact triangles (Model::contact_triangles), moving from `start` to `end` [m] over a sub-step
+  /// of h [s], meet a collider's edges, corners or thin parts between their nodes (face_contacts.h; their
+  /// nodes are `touching`'s), each within `margin` [m] of touching at the sub-step's end, the colliders
+  /// moved on by their velocities: into `found` (cleared first).
+  virtual void touchingFaces(const Model& /*model*/, const NodeArray& /*start*/, const NodeArray& /*end*/,
+                             double /*h*/, double /*margin*/, std::vector<FaceContact>& found) const
+  {
+    found.clear();
+  }
 };
 
 /// The forces inside the bodies in the last sub-step, as an integrator's solve had them.

@@ -58,9 +58,20 @@ void ColliderHolds::find(const NewtonPoint& point, const ContactQuery& contacts)
   {
     if (!held_node_[static_cast<std::size_t>(i)] || !model.isFree(i))
       continue;
-    const Vec3 predicted = point.x.col(i) + point.offset.col(i);
+    const Vec3 start = point.x.col(i), predicted = start + point.offset.col(i);
     if (!contacts.touching(model, i, predicted, margin, contact))
       continue;
+    // The normal from where the node starts the step, if the same collider is nearest there: the side it is
+    // pushed to is the side it came from (from x + h v, a node carried past a thin rail's axis within the
+    // step would be pushed out through its far side); the depth at x + h v along it, planar about the start.
+    const Vec3 moved = predicted - start;
+    NodeContact from_start;
+    if (contacts.touching(model, i, start, margin + moved.norm() + point.h * contact.velocity.norm(), from_start) &&
+        from_start.collider == contact.collider)
+    {
+      from_start.depth -= from_start.normal.dot(moved);
+      contact = from_start;
+    }
     const double depth = contact.depth + point.h * contact.velocity.dot(contact.normal);
     if (depth > (hold_force_[static_cast<std::size_t>(i)] < 0.0 ? 0.0 : -margin))
       holds_.push_back({ i, contact, predicted, depth, depth, 0.0, 0.0, Vec3::Zero() });

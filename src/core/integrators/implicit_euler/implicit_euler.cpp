@@ -67,7 +67,8 @@ public:
     start_v_ = state.velocity;
     if (!analyzed_)
       analyze(model);
-    for (int k = 0; k < iterations; ++k)
+    int planned = iterations;
+    for (int k = 0; k < planned; ++k)
     {
       const NodeArray& v_k = state.velocity;
       // x_lin and the offset x_n + h v_k - x_lin at which K acts: x_lin = x_n on the first iteration (the
@@ -89,7 +90,12 @@ public:
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
           state.velocity.col(i) += delta_v_.col(i);
-      if (k + 1 < iterations)
+      // One more iteration where the velocities carry a triangle into a collider that no hold holds off
+      // (findMissedFaces), at most kMissedFacePasses more.
+      if (k + 1 == planned && planned < iterations + kMissedFacePasses && contacts_ != nullptr &&
+          surface_holds_.findMissedFaces(model, start_x_, state.velocity, h, *contacts_))
+        ++planned;
+      if (k + 1 < planned)
       {
         if (contacts_ != nullptr)
           collider_holds_.letGoPulling(h, delta_v_);
@@ -182,6 +188,9 @@ private:
       surface_holds_.placePairs(system_);
     system_.solve(Blocks{ model, kinds_, surface_holds_ }, surface_holds_.empty(), delta_v_);
   }
+
+  /// The most Newton iterations a step adds for face contacts its solve alone ran into.
+  static constexpr int kMissedFacePasses = 2;
 
   BlockSystem system_;
   KindBlocks kinds_;

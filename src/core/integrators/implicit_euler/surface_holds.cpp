@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/contact/face_contacts.h"
 #include "core/integrators/implicit_euler/hold_friction.h"
 
 namespace soft_body_sim
@@ -32,6 +33,8 @@ void SurfaceHolds::analyze(const Model& model, const BlockSystem& system)
       triangle_first_.push_back(s);
   triangle_first_.push_back(samples.size());
   holds_.reserve(holds_.capacity() + samples.size());
+  faces_ = !model.contact_triangles.empty();
+  face_force_.clear();
 }
 
 void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& colliders)
@@ -122,6 +125,75 @@ void SurfaceHolds::findSamples(const NewtonPoint& point, const ContactQuery& col
   }
 }
 
+void SurfaceHolds::findFaces(const NewtonPoint& point, const ContactQuery& colliders)
+{
+  const Model& model = point.model;
+  const double margin = model.gravity.norm() * point.h * point.h;
+  colliders.touchingFaces(model, point.x, predicted_, point.h, margin, faces_found_);
+  for (std::size_t k = 0; k < faces_found_.size(); ++k)
+  {
+    const FaceContact& face = faces_found_[k];
+    // Held while it is in at x + h v, or, if it pushed in the last step, within |g| h^2 of that.
+    if (face.contact.depth > 0.0 || (lastForce(face) > 0.0 && face.contact.depth > -margin))
+      holdFace(model, k);
+  }
+}
+
+bool SurfaceHolds::findMissedFaces(const Model& model, const NodeArray& x, const NodeArray& v, double h,
+                                   const ContactQuery& colliders)
+{
+  if (!faces_)
+    return false;
+  held_faces_.clear();
+  for (const Hold& c : holds_)
+    if (c.face >= 0)
+    {
+      const FaceContact& face = faces_found_[static_cast<std::size_t>(c.face)];
+      held_faces_.emplace_back(face.triangle, face.contact.collider, face.feature);
+    }
+  std::sort(held_faces_.begin(), held_faces_.end());
+  predicted_ = x + h * v;
+  colliders.touchingFaces(model, x, predicted_, h, 0.0, faces_more_);
+  bool found = false;
+  for (const FaceContact& face : faces_more_)
+  {
+    // Missed: in by more than its thickness, so into the shape itself (a face keeps kFaceSag of it from the
+    // shape); one that only came into its thickness is the contact stage's, as before the solve knew it.
+    if (!(face.contact.depth > triangleThickness(model, model.contact_triangles[face.triangle])) ||
+        std::binary_search(held_faces_.begin(), held_faces_.end(),
+                           FaceKey{ face.triangle, face.contact.collider, face.feature }))
+      continue;
+    faces_found_.push_back(face);
+    holdFace(model, faces_found_.size() - 1);
+    found = true;
+  }
+  return found;
+}
+
+void SurfaceHolds::holdFace(const Model& model, std::size_t k)
+{
+  const FaceContact& face = faces_found_[k];
+  const std::array<int, 3>& triangle = model.contact_triangles[face.triangle];
+  const Vec3 predicted = face.weight[0] * predicted_.col(triangle[0]) + face.weight[1] * predicted_.col(triangle[1]) +
+                         face.weight[2] * predicted_.col(triangle[2]);
+  // As a sample's hold: the collider in p's place.
+  Hold c;
+  c.touch = SurfaceTouch{ { triangle[0], triangle[0], triangle[1], triangle[2] },
+                          { 0.0, -face.weight[0], -face.weight[1], -face.weight[2] },
+                          -face.contact.normal,
+                          -predicted,
+                          face.contact.depth,
+                          face.contact.friction };
+  c.nodes[0] = -1;
+  for (std::size_t l = 1; l < 4; ++l)
+    c.nodes[l] = face.weight[l - 1] != 0.0 && model.isFree(c.touch.nodes[l]) ? c.touch.nodes[l] : -1;
+  c.depth = c.scaled = 0.0;
+  c.block.setZero();
+  c.face = static_cast<int>(k);
+  c.contact = face.contact;
+  holds_.push_back(c);
+}
+
 void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, BlockSystem& system,
                             const ContactQuery* colliders)
 {
@@ -144,7 +216,7 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
       relative += weight * point.v.col(node);
       if (c.nodes[l] >= 0)
         inverse_block += weight * weight /
-                         (c.sample >= 0 ? point.model.mass[c.nodes[l]] : system.diagonal(c.nodes[l]).trace() / 3.0);
+                         (c.onCollider() ? point.model.mass[c.nodes[l]] : system.diagonal(c.nodes[l]).trace() / 3.0);
     }
     c.depth = c.touch.depth - n.dot(gap - c.touch.gap);
     c.scaled = 0.0;
@@ -152,14 +224,16 @@ void SurfaceHolds::assemble(const NewtonPoint& point, bool first_iteration, Bloc
     if (!(inverse_block > 0.0))
       continue;  // all four pinned
     const double block = 1.0 / inverse_block;  // b [kg]
-    // A sample's: no stiffer than at sub-steps of kStiffestSampleStep.
+    // A triangle's point on a collider: no stiffer than at sub-steps of kStiffestSampleStep.
     const double shorter = h < kStiffestSampleStep ? (h * h) / (kStiffestSampleStep * kStiffestSampleStep) : 1.0;
-    c.scaled = (c.sample >= 0 ? kContactStiffness * shorter : kContactStiffness) * block;
+    c.scaled = (c.onCollider() ? kContactStiffness * shorter : kContactStiffness) * block;
     Vec3 push = (c.scaled / h * c.depth) * n;
     c.block = c.scaled * (n * n.transpose());
-    if (c.sample >= 0)
+    if (c.onCollider())
       relative += c.contact.velocity;
-    const double known = c.sample >= 0 ? sample_force_[static_cast<std::size_t>(c.sample)] : lastForce(c.touch);
+    const double known = c.sample >= 0  ? sample_force_[static_cast<std::size_t>(c.sample)]
+                         : c.face >= 0 ? lastForce(faces_found_[static_cast<std::size_t>(c.face)])
+                                       : lastForce(c.touch);
     const double normal_force = std::max(block * c.depth / (h * h), known);
     Vec3 tangential;
     const double damping = frictionDamping(c.touch.friction, normal_force, relative, n, tangential);
@@ -181,11 +255,13 @@ void SurfaceHolds::find(const NewtonPoint& point, const ContactQuery* colliders)
   const Model& model = point.model;
   const double margin = model.gravity.norm() * point.h * point.h;
   holds_.clear();
+  predicted_ = point.x + point.offset;
   if (colliders != nullptr && !sample_force_.empty())
     findSamples(point, *colliders);
+  if (colliders != nullptr && faces_)
+    findFaces(point, *colliders);
   if (!contacts_.has_value())
     return;
-  predicted_ = point.x + point.offset;
   contacts_->find(model, point.x, predicted_, std::max(margin, 0.5 * contacts_->widestRadius()), touches_);
   for (const SurfaceTouch& touch : touches_)
   {
@@ -270,6 +346,14 @@ double SurfaceHolds::lastForce(const SurfaceTouch& touch) const
   return found != edge_force_.end() && found->first == touch.edges ? found->second : 0.0;
 }
 
+double SurfaceHolds::lastForce(const FaceContact& face) const
+{
+  const FaceKey key{ face.triangle, face.contact.collider, face.feature };
+  const auto found = std::lower_bound(face_force_.begin(), face_force_.end(), key,
+                                      [](const auto& known, const FaceKey& wanted) { return known.first < wanted; });
+  return found != face_force_.end() && found->first == key ? found->second : 0.0;
+}
+
 double SurfaceHolds::force(const Hold& hold, double h, const NodeArray& dv)
 {
   Vec3 moved = Vec3::Zero();
@@ -294,10 +378,11 @@ void SurfaceHolds::noteForces(double h, const NodeArray& dv, ContactQuery* colli
   std::fill(hold_force_.begin(), hold_force_.end(), 0.0);
   std::fill(sample_force_.begin(), sample_force_.end(), 0.0);
   edge_force_.clear();
+  face_force_.clear();
   for (const Hold& c : holds_)
   {
     const double normal_force = force(c, h, dv);
-    if (c.sample < 0)
+    if (!c.onCollider())
     {
       if (c.touch.edges >= 0)
         edge_force_.emplace_back(c.touch.edges, normal_force);
@@ -305,7 +390,13 @@ void SurfaceHolds::noteForces(double h, const NodeArray& dv, ContactQuery* colli
         hold_force_[static_cast<std::size_t>(c.touch.nodes[0])] = normal_force;
       continue;
     }
-    sample_force_[static_cast<std::size_t>(c.sample)] = normal_force;
+    if (c.sample >= 0)
+      sample_force_[static_cast<std::size_t>(c.sample)] = normal_force;
+    else
+    {
+      const FaceContact& face = faces_found_[static_cast<std::size_t>(c.face)];
+      face_force_.emplace_back(FaceKey{ face.triangle, face.contact.collider, face.feature }, normal_force);
+    }
     if (colliders == nullptr)
       continue;
     // On the triangle's point: the push along the collider's normal and friction's pull towards its velocity.
@@ -318,6 +409,7 @@ void SurfaceHolds::noteForces(double h, const NodeArray& dv, ContactQuery* colli
     colliders->receive(c.contact, -c.touch.gap - c.touch.depth * c.contact.normal, -h * on_point);
   }
   std::sort(edge_force_.begin(), edge_force_.end());
+  std::sort(face_force_.begin(), face_force_.end());
 }
 
 }  // namespace soft_body_sim

@@ -28,6 +28,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -46,7 +47,7 @@ public:
   /// `system`: the holds' pairs come after them.
   void analyze(const Model& model, const BlockSystem& system);
   /// Whether the model can have surface holds at all.
-  bool present() const { return contacts_.has_value() || !sample_force_.empty(); }
+  bool present() const { return contacts_.has_value() || !sample_force_.empty() || faces_; }
   /// Whether the Newton iteration being assembled has any.
   bool empty() const { return holds_.empty(); }
 
@@ -82,6 +83,13 @@ public:
     }
   }
 
+  /// After a Newton iteration that solved velocities v from positions x: holds the contact triangles' points
+  /// that x + h v carries into a collider's edge, corner or thin part and that no hold has yet; true if there
+  /// are any (then the solve should be repeated with them). The prediction x + h v_n that found the step's
+  /// holds knows nothing of the solve's own forces: a taut cloth's wing that its tension swings round a finger
+  /// within a step (measured: 5 cm at 1/60 s) would sweep through it.
+  bool findMissedFaces(const Model& model, const NodeArray& x, const NodeArray& v, double h,
+                       const ContactQuery& colliders);
   /// As ColliderHolds::letGoPulling.
   void letGoPulling(double h, const NodeArray& dv);
   /// As ColliderHolds::noteForces; the surface samples' impulses go to `colliders`.
@@ -98,17 +106,31 @@ private:
     /// Model::surface_samples' index of a sample held on a collider (then the collider is p: no node, weight
     /// 0); -1: a node p on a solid's surface
     int sample = -1;
-    /// the collider a sample touches (its normal points out of the collider)
+    /// faces_found_'s index of a contact triangle's point held on a collider (as a sample); -1: none
+    int face = -1;
+    /// the collider a sample or a face touches (its normal points out of the collider)
     NodeContact contact{ Vec3::Zero(), Vec3::Zero() };
     double damping = 0.0;   ///< c [kg/s] of its friction in this iteration
     Vec3 slip = Vec3::Zero();  ///< the relative velocity across n that friction damped, before the solve
+
+    /// A triangle's point held on a collider (a sample or a face): the collider in p's place.
+    bool onCollider() const { return sample >= 0 || face >= 0; }
   };
+  /// A face contact's name from step to step: its triangle, collider and the collider's feature.
+  using FaceKey = std::tuple<std::size_t, int, std::size_t>;
   void find(const NewtonPoint& point, const ContactQuery* colliders);
   /// Holds every surface sample that is in a collider at x + h v (a triangle's points only where a collider
   /// comes within the triangle's reach).
   void findSamples(const NewtonPoint& point, const ContactQuery& colliders);
+  /// Holds every contact triangle's point that a collider's edge, corner or thin part is in at x + h v
+  /// (ContactQuery::touchingFaces; a node's own contact is ColliderHolds'), as a sample is held.
+  void findFaces(const NewtonPoint& point, const ContactQuery& colliders);
+  /// Holds faces_found_[k] (findFaces) as a sample is held: the collider in p's place.
+  void holdFace(const Model& model, std::size_t k);
   /// [N] the force the hold of a node or of two edges took in the last step (> 0 pushing), 0 if it had none.
   double lastForce(const SurfaceTouch& touch) const;
+  /// [N] the force a face contact's hold took in the last step (> 0 pushing), 0 if it had none.
+  double lastForce(const FaceContact& face) const;
   /// k (d - h n . sum_l weights_l dv_l) [N]: the force `hold` took in the Newton iteration that solved dv
   /// (> 0 pushing).
   static double force(const Hold& hold, double h, const NodeArray& dv);
@@ -142,6 +164,11 @@ private:
   /// per sampled triangle, its first sample in Model::surface_samples (and one past the last)
   std::vector<std::size_t> triangle_first_;
   std::vector<double> sample_force_;         ///< per surface sample: [N] as hold_force_; empty: no samples
+  bool faces_ = false;                       ///< the model has contact triangles (face contacts)
+  std::vector<FaceContact> faces_found_;     ///< the face contacts found in a step (its holds' `face`)
+  std::vector<FaceContact> faces_more_;      ///< findMissedFaces' contacts
+  std::vector<FaceKey> held_faces_;          ///< findMissedFaces': the held faces' keys, sorted
+  std::vector<std::pair<FaceKey, double>> face_force_;  ///< the faces' holds' [N] in the last step, by key
 };
 
 }  // namespace soft_body_sim
