@@ -31,6 +31,16 @@ Vec3 contactGap(const NodeArray& x, const std::pair<int, int>& from, const std::
   return (xa + p * along_from) - (xc + q * along_to);
 }
 
+/// The two segments' least distance [m]: contactGap's without the near-parallel rule, which may take ends
+/// farther apart than the lines' nearest points; so never more than contactGap's.
+double leastDistance(const NodeArray& x, const std::pair<int, int>& from, const std::pair<int, int>& to)
+{
+  const Vec3 xa = x.col(from.first), xc = x.col(to.first);
+  const Vec3 along_from = x.col(from.second) - xa, along_to = x.col(to.second) - xc;
+  const auto [p, q] = closestSegmentParameters(xa, along_from, xc, along_to);
+  return ((xa + p * along_from) - (xc + q * along_to)).norm();
+}
+
 /// Coulomb friction at a contact of unit normal n: the change of `relative` (a motion, or a velocity, at
 /// the contact) that cancels its tangential part up to friction * budget, what it takes spent from budget;
 /// none if it has no tangential part.
@@ -173,7 +183,7 @@ void SelfContacts::remember(const State& state)
     start_ = state.position;
 }
 
-bool SelfContacts::candidatesHold(const NodeArray& x) const
+bool SelfContacts::candidatesHold(const NodeArray& x)
 {
   if (found_at_.cols() != x.cols())
     return false;
@@ -186,8 +196,12 @@ bool SelfContacts::candidatesHold(const NodeArray& x) const
   mean /= static_cast<double>(nodes_.size());
   const double limit = 0.25 * skin_ * skin_;
   for (const int node : nodes_)
-    if ((x.col(node) - found_at_.col(node) - mean).squaredNorm() > limit)
+  {
+    const double moved2 = (x.col(node) - found_at_.col(node) - mean).squaredNorm();
+    if (moved2 > limit)
       return false;
+    moved_[static_cast<std::size_t>(node)] = std::sqrt(moved2);
+  }
   return true;
 }
 
@@ -205,6 +219,7 @@ void SelfContacts::findCandidates(const NodeArray& x)
   // within the longest link and that: the cells' width.
   grid_.build(x, segments_, longest + 4.0 * largest_radius_ + skin_ + 1e-9);
   candidates_.clear();
+  candidate_distance_.clear();
   grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
@@ -244,9 +259,11 @@ void SelfContacts::findCandidates(const NodeArray& x)
         contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
       return;
     candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
+    candidate_distance_.push_back(leastDistance(x, segments_[s], segments_[t]));
   });
   findFaceCandidates(x);
   found_at_ = x;
+  moved_.assign(static_cast<std::size_t>(x.cols()), 0.0);
   ++searches_;
 }
 
@@ -306,10 +323,22 @@ bool SelfContacts::resolve(const Model& model, State& state)
     findCandidates(x);
   // The pairs that touch, or nearly (within their radii again, as the passes move them).
   near_.clear();
-  for (const auto& [s, t] : candidates_)
+  const auto moved = [&](const std::pair<int, int>& segment) {
+    return std::max(moved_[static_cast<std::size_t>(segment.first)], moved_[static_cast<std::size_t>(segment.second)]);
+  };
+  for (std::size_t k = 0; k < candidates_.size(); ++k)
   {
+    const auto [s, t] = candidates_[k];
+    const double touching = 2.0 * (radius_[s] + radius_[t]);
+    // Their points have moved, relative to the mean motion (which changes no distance), no farther than
+    // their farthest node: a pair whose least distance was more than that beyond the contact distance is
+    // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
+    // sub-step until the list is found again). A hair's margin keeps the rounding of the bound on the safe
+    // side.
+    if (candidate_distance_[k] - moved(segments_[s]) - moved(segments_[t]) > touching * (1.0 + 1e-9) + 1e-12)
+      continue;
     double p, q;
-    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
+    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < touching)
       near_.push_back({ s, t, 0.0, 0.0 });
   }
   bool touched = false;

@@ -118,8 +118,8 @@ public:
 
 private:
   /// True if no node of a colliding link has moved half the skin, relative to their mean motion, since
-  /// the candidates were found.
-  bool candidatesHold(const NodeArray& x) const;
+  /// the candidates were found; each node's distance so moved into moved_.
+  bool candidatesHold(const NodeArray& x);
   /// The pairs within twice their radii and the skin, through the spatial hash.
   void findCandidates(const NodeArray& x);
 
@@ -156,7 +156,11 @@ private:
   std::vector<double> half_;                   ///< per segment: half its length then [m]
   SegmentGrid grid_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates_;  ///< pairs that may touch
+  std::vector<double> candidate_distance_;     ///< per candidate: the links' least distance when found [m]
   NodeArray found_at_;                         ///< positions when the candidates were found [m]
+  /// per node (global index): how far it has moved since the candidates were found, relative to the
+  /// colliding nodes' mean motion [m] (candidatesHold)
+  std::vector<double> moved_;
   std::size_t searches_ = 0;
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
