@@ -321,35 +321,10 @@ bool SelfContacts::resolve(const Model& model, State& state)
   NodeArray& v = state.velocity;
   if (!candidatesHold(x))
     findCandidates(x);
-  // The pairs that touch, or nearly (within their radii again, as the passes move them).
-  near_.clear();
-  const auto moved = [&](const std::pair<int, int>& segment) {
-    return std::max(moved_[static_cast<std::size_t>(segment.first)], moved_[static_cast<std::size_t>(segment.second)]);
-  };
-  for (std::size_t k = 0; k < candidates_.size(); ++k)
-  {
-    const auto [s, t] = candidates_[k];
-    const double touching = 2.0 * (radius_[s] + radius_[t]);
-    // Their points have moved, relative to the mean motion (which changes no distance), no farther than
-    // their farthest node: a pair whose least distance was more than that beyond the contact distance is
-    // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
-    // sub-step until the list is found again). A hair's margin keeps the rounding of the bound on the safe
-    // side.
-    if (candidate_distance_[k] - moved(segments_[s]) - moved(segments_[t]) > touching * (1.0 + 1e-9) + 1e-12)
-      continue;
-    double p, q;
-    if (contactGap(x, segments_[s], segments_[t], p, q).norm() < touching)
-      near_.push_back({ s, t, 0.0, 0.0 });
-  }
-  bool touched = false;
   const Eigen::VectorXd& w = model.inverse_mass;
-  // The contact of pair k at the current positions: the nearest points' parameters, the unit normal from
-  // t's link to s's, the distance and each node's share; false if there is no direction or no free node.
-  struct Contact
-  {
-    double p, q, distance, ka, kb, kc, kd, weight;
-    Vec3 n;
-  };
+  // The contact of segments s and t at the current positions: the nearest points' parameters, the unit
+  // normal from t's link to s's, the distance and each node's share; false if there is no direction or no
+  // free node.
   const auto contact = [&](std::size_t s, std::size_t t, Contact& k) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
@@ -365,14 +340,62 @@ bool SelfContacts::resolve(const Model& model, State& state)
     k.weight = (1.0 - k.p) * k.ka + k.p * k.kb + (1.0 - k.q) * k.kc + k.q * k.kd;
     return k.weight > 0.0;
   };
+  // The pairs that touch, or nearly (within their radii again, as the passes move them).
+  near_.clear();
+  moved_at_.resize(static_cast<std::size_t>(x.cols()), 0);
+  const auto moved = [&](const std::pair<int, int>& segment) {
+    return std::max(moved_[static_cast<std::size_t>(segment.first)], moved_[static_cast<std::size_t>(segment.second)]);
+  };
+  for (std::size_t c = 0; c < candidates_.size(); ++c)
+  {
+    const auto [s, t] = candidates_[c];
+    const double touching = 2.0 * (radius_[s] + radius_[t]);
+    // Their points have moved, relative to the mean motion (which changes no distance), no farther than
+    // their farthest node: a pair whose least distance was more than that beyond the contact distance is
+    // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
+    // sub-step until the list is found again). A hair's margin keeps the rounding of the bound on the safe
+    // side.
+    if (candidate_distance_[c] - moved(segments_[s]) - moved(segments_[t]) > touching * (1.0 + 1e-9) + 1e-12)
+      continue;
+    NearPair pair{ s, t, 0.0, 0.0 };
+    pair.valid = contact(s, t, pair.contact);
+    pair.seen = tick_;
+    if (pair.contact.distance < touching)
+      near_.push_back(pair);
+  }
+  bool touched = false;
+  // A pair's contact as the passes left its nodes: the one it last had unless one of its nodes has moved
+  // since (most pairs of a cloth lying in folds touch none that moves: their nearest points are not
+  // looked for again, pass after pass; the same contacts and bits).
+  const auto current = [&](NearPair& pair) -> const Contact* {
+    const auto [a, b] = segments_[pair.s];
+    const auto [c, d] = segments_[pair.t];
+    const std::uint64_t last_move =
+        std::max({ moved_at_[static_cast<std::size_t>(a)], moved_at_[static_cast<std::size_t>(b)],
+                   moved_at_[static_cast<std::size_t>(c)], moved_at_[static_cast<std::size_t>(d)] });
+    if (last_move > pair.seen)
+    {
+      pair.valid = contact(pair.s, pair.t, pair.contact);
+      pair.seen = tick_;
+    }
+    return pair.valid ? &pair.contact : nullptr;
+  };
   // Changes y (positions or velocities) of the four nodes so that the difference between the two nearest
   // points changes by `change`, each node by its share of the inverse mass there.
   const auto part = [&](std::size_t s, std::size_t t, const Contact& k, NodeArray& y, const Vec3& change) {
     const Vec3 unit = change / k.weight;
-    y.col(segments_[s].first) += k.ka * unit;
-    y.col(segments_[s].second) += k.kb * unit;
-    y.col(segments_[t].first) -= k.kc * unit;
-    y.col(segments_[t].second) -= k.kd * unit;
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    y.col(a) += k.ka * unit;
+    y.col(b) += k.kb * unit;
+    y.col(c) -= k.kc * unit;
+    y.col(d) -= k.kd * unit;
+    if (&y == &x)
+    {
+      ++tick_;
+      for (const int node : { a, b, c, d })
+        moved_at_[static_cast<std::size_t>(node)] = tick_;
+    }
   };
   // The difference of y (positions or velocities) between the two nearest points.
   const auto between = [&](std::size_t s, std::size_t t, const Contact& k, const NodeArray& y) {
@@ -385,12 +408,13 @@ bool SelfContacts::resolve(const Model& model, State& state)
   // inside a link moves its nearer node by more than the depth there; without taking back, a neighbouring
   // pair's push on that node would leave it thrown off the surface (and in a groove, off with no friction
   // holding it).
-  Contact k;
   for (int pass = 0; pass < kPasses; ++pass)
     for (NearPair& pair : near_)
     {
-      if (!contact(pair.s, pair.t, k))
+      const Contact* found = current(pair);
+      if (found == nullptr)
         continue;
+      const Contact k = *found;
       const double push = std::max(-pair.push, radius_[pair.s] + radius_[pair.t] - k.distance);
       // Only links that touch stop approaching; others give back what they took.
       const double stop = pair.push + push > 0.0 ? std::max(-pair.stop, -between(pair.s, pair.t, k, v).dot(k.n))
@@ -414,8 +438,12 @@ bool SelfContacts::resolve(const Model& model, State& state)
     for (NearPair& pair : near_)
     {
       const double friction = 0.5 * (friction_[pair.s] + friction_[pair.t]);
-      if (!(friction > 0.0) || !(pair.push > 0.0 || pair.stop > 0.0) || !contact(pair.s, pair.t, k))
+      if (!(friction > 0.0) || !(pair.push > 0.0 || pair.stop > 0.0))
         continue;
+      const Contact* found = current(pair);
+      if (found == nullptr)
+        continue;
+      const Contact k = *found;
       // Cancels the tangential part of `relative` (a motion of y at the contact) up to friction * budget.
       const auto resist = [&](const Vec3& relative, double& budget, NodeArray& y) {
         if (const std::optional<Vec3> change = frictionChange(relative, k.n, friction, budget))

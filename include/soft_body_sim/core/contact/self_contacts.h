@@ -162,14 +162,28 @@ private:
   /// colliding nodes' mean motion [m] (candidatesHold)
   std::vector<double> moved_;
   std::size_t searches_ = 0;
+  /// Two links' contact at some positions: their nearest points' parameters p (on s) and q (on t), the
+  /// distance [m] and unit normal n from t's point to s's, each node's share (its weight there times its
+  /// inverse mass) and their sum weighted again (resolve).
+  struct Contact
+  {
+    double p, q, distance, ka, kb, kc, kd, weight;
+    Vec3 n;
+  };
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
   {
     std::uint32_t s, t;  ///< segment indices
     double push;         ///< [m] the normal passes' push apart, less what friction has cancelled / mu
     double stop;         ///< [m/s] the approach speed they removed, likewise
+    Contact contact{};   ///< its contact when last looked at (at tick `seen`)
+    bool valid = false;  ///< that contact has a direction and a free node
+    std::uint64_t seen = 0;
   };
   std::vector<NearPair> near_;
+  /// per node (global index): the tick_ of the last push that moved it
+  std::vector<std::uint64_t> moved_at_;
+  std::uint64_t tick_ = 0;  ///< counts resolve's pushes of positions, over all sub-steps
 
   std::vector<std::array<int, 3>> faces_;  ///< the contact triangles of the colliding cloths
   std::vector<int> face_body_;             ///< per face: its body
