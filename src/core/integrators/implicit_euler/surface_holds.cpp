@@ -152,7 +152,11 @@ bool SurfaceHolds::findMissedFaces(const Model& model, const NodeArray& x, const
       held_faces_.emplace_back(face.triangle, face.contact.collider, face.feature);
     }
   std::sort(held_faces_.begin(), held_faces_.end());
-  predicted_ = x + h * v;
+  // Where the next Newton iteration linearises: x + h v, the pinned nodes where they are.
+  predicted_ = x;
+  for (int i = 0; i < model.nodeCount(); ++i)
+    if (model.isFree(i))
+      predicted_.col(i) += h * v.col(i);
   colliders.touchingFaces(model, x, predicted_, h, 0.0, faces_more_);
   bool found = false;
   for (const FaceContact& face : faces_more_)
