@@ -319,6 +319,45 @@ TEST(StepAllocation, ImplicitEulerOnAPressedSolidAllocatesNothing)
   EXPECT_TRUE(world.state().position.allFinite());
 }
 
+// A face-contact cloth lying on a rail thinner than its spacing, its faces held on it inside
+// implicit_euler's solve (surface_holds.h) and its contact stage's face pushes after it: once it rests,
+// its steps allocate nothing.
+TEST(StepAllocation, ImplicitEulerOnAClothRestingOnARailByItsFacesAllocatesNothing)
+{
+  SceneDef scene;
+  scene.physics.integrator = IntegratorType::ImplicitEuler;
+  scene.physics.step = StepSettings{ 1.0 / 60.0, 1, 1 };
+  scene.physics.drag = 2.0;
+  Capsule rail;
+  rail.at.name = "rail";
+  rail.at.position = Vec3(0.0, 0.0, 0.5);
+  rail.at.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(M_PI / 2.0, Vec3::UnitY()));
+  rail.at.friction = 0.5;
+  rail.radius = 0.005;
+  rail.length = 0.8;
+  scene.colliders.capsules.push_back(rail);
+  ClothDef cloth;
+  cloth.nx = 11;
+  cloth.ny = 11;
+  cloth.corners.top_left = Vec3(-0.25, 0.275, 0.52);
+  cloth.corners.top_right = Vec3(0.25, 0.275, 0.52);
+  cloth.corners.bottom_left = Vec3(-0.25, -0.225, 0.52);
+  cloth.mass = 0.1;
+  cloth.thickness = 0.005;
+  cloth.face_contacts = true;
+  scene.bodies.push_back(buildCloth("cloth", cloth));
+  World world = buildWorld(scene);
+  while (world.time() < 3.0)
+    world.step();
+  ASSERT_GT(world.state().position.row(2).maxCoeff(), 0.5) << "the cloth fell off or through the rail";
+  const long allocations = allocationsOf([&] {
+    for (int n = 0; n < 60; ++n)
+      world.step();
+  });
+  EXPECT_EQ(allocations, 0);
+  EXPECT_TRUE(world.state().position.allFinite());
+}
+
 TEST(StepAllocation, TheCounterSeesOperatorNewAndEigen)
 {
   // The interposed allocator must see what a step could allocate, or the test above proves nothing.
