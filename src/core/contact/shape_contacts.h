@@ -135,7 +135,7 @@ public:
   {
     if (!model.contact_triangles.empty())
     {
-      placeFeatures(start_features_);
+      placeFeatures(start_features_, 0.0);
       start_positions_.clear();
       start_orientations_.clear();
       for (const Shape& shape : shapes_)
@@ -186,7 +186,7 @@ public:
       touched_any = resolveSegment(model, start, state, h, a, b) || touched_any;
     if (!model.contact_triangles.empty())
     {
-      placeFeatures(features_now_);
+      placeFeatures(features_now_, 0.0);
       placeGroups(group_centres_now_, group_centres_then_);
       boxTriangles(model, start, state.position);
       touched_features_.clear();
@@ -234,36 +234,13 @@ public:
   {
     if (model.contact_triangles.empty())
       return;
-    // The features where the shapes are (the sub-step's start) and where their velocities take them by its
-    // end, and each shape's box over both, as the contact stage has them (boxTriangles, placeGroups).
-    placeFeatures(query_start_);
-    query_end_.resize(shapes_.size());
-    query_groups_.resize(shapes_.size());
-    query_boxes_.resize(shapes_.size());
-    const double widest = model.contact_radius.maxCoeff();
-    for (std::size_t k = 0; k < shapes_.size(); ++k)
-    {
-      const auto [position, orientation] = advanced(shapes_[k].at, h);
-      query_end_[k].clear();
-      query_boxes_[k].setEmpty();
-      for (std::size_t f = 0; f < features_[k].size(); ++f)
-      {
-        const ShapeFeature& local = features_[k][f];
-        query_end_[k].push_back({ position + orientation * local.a, position + orientation * local.b, local.radius,
-                                  local.flat_ends });
-        const double reach = local.radius + widest + margin;
-        for (const ShapeFeature* feature : { &query_end_[k][f], &query_start_[k][f] })
-          for (const Vec3& point : { feature->a, feature->b })
-          {
-            query_boxes_[k].extend(Vec3(point.array() - reach));
-            query_boxes_[k].extend(Vec3(point.array() + reach));
-          }
-      }
-      query_groups_[k].clear();
-      for (const FeatureGroup& group : groups_[k])
-        query_groups_[k].emplace_back(position + orientation * group.centre,
-                                      shapes_[k].at.position + shapes_[k].at.orientation * group.centre);
-    }
+    // The features and their groups' centres where the shapes are (the sub-step's start) and where their
+    // velocities take them by its end, and each shape's box over both, as the contact stage has them.
+    placeFeatures(query_start_, 0.0);
+    placeFeatures(query_end_, h);
+    placeGroupCentres(query_centres_start_, 0.0);
+    placeGroupCentres(query_centres_end_, h);
+    boxShapes(query_end_, query_start_, model.contact_radius.maxCoeff() + margin, query_boxes_);
     for (std::size_t t = 0; t < model.contact_triangles.size(); ++t)
     {
       const std::array<int, 3>& triangle = model.contact_triangles[t];
@@ -287,28 +264,21 @@ public:
           ball.emplace(now, then);
         const ColliderPlacement& at = shapes_[k].at;
         const Vec3 centre_end = at.position + h * at.velocity;
-        for (std::size_t g = 0; g < groups_[k].size(); ++g)
-        {
-          const FeatureGroup& group = groups_[k][g];
-          if (!ball->meets(query_groups_[k][g].first, query_groups_[k][g].second, group.radius + thickness + margin))
-            continue;
-          for (std::size_t f = group.first; f < group.last; ++f)
-          {
-            if (!ball->meetsSegment(query_end_[k][f], query_start_[k][f], thickness + margin))
-              continue;
-            // Within the margin: the thicknesses widened by it, the depth taken back.
-            const std::optional<FaceTouch> touch = faceTouch(query_end_[k][f], query_start_[k][f], now, then,
-                                                             thickness + margin, kFaceSag * thickness + margin);
-            // A corner is its node's contact (`touching`).
-            if (!touch || touch->weight.maxCoeff() >= 1.0)
-              continue;
-            const Vec3 velocity = at.velocity + at.angular_velocity.cross(touch->contact - centre_end);
-            found.push_back({ t, touch->weight,
-                              NodeContact{ touch->normal, velocity, at.friction, touch->depth - margin,
-                                           first + static_cast<int>(k) },
-                              f });
-          }
-        }
+        forEachFeatureNear(k, *ball, thickness + margin, query_centres_end_[k], query_centres_start_[k], query_end_[k],
+                           query_start_[k], [&](std::size_t f) {
+                             // Within the margin: the thicknesses widened by it, the depth taken back.
+                             const std::optional<FaceTouch> touch =
+                                 faceTouch(query_end_[k][f], query_start_[k][f], now, then, thickness + margin,
+                                           kFaceSag * thickness + margin);
+                             // A corner is its node's contact (`touching`).
+                             if (!touch || touch->weight.maxCoeff() >= 1.0)
+                               return;
+                             const Vec3 velocity = at.velocity + at.angular_velocity.cross(touch->contact - centre_end);
+                             found.push_back({ t, touch->weight,
+                                               NodeContact{ touch->normal, velocity, at.friction, touch->depth - margin,
+                                                            first + static_cast<int>(k) },
+                                               f });
+                           });
       }
     }
   }
@@ -463,23 +433,15 @@ private:
       if (!ball)
         ball.emplace(corners(), then);
       bool touched_shape = false;
-      for (std::size_t g = 0; g < groups_[k].size(); ++g)
-      {
-        const FeatureGroup& group = groups_[k][g];
-        if (!ball->meets(group_centres_now_[k][g], group_centres_then_[k][g], group.radius + thickness))
-          continue;
-        for (std::size_t f = group.first; f < group.last; ++f)
-        {
-          if (!ball->meetsSegment(features_now_[k][f], start_features_[k][f], thickness))
-            continue;
-          const TouchedFeature feature{ index, k, f };
-          if (touchFeature(model, start, state, h, feature))
-          {
-            touched_features_.push_back(feature);
-            touched_shape = true;
-          }
-        }
-      }
+      forEachFeatureNear(k, *ball, thickness, group_centres_now_[k], group_centres_then_[k], features_now_[k],
+                         start_features_[k], [&](std::size_t f) {
+                           const TouchedFeature feature{ index, k, f };
+                           if (touchFeature(model, start, state, h, feature))
+                           {
+                             touched_features_.push_back(feature);
+                             touched_shape = true;
+                           }
+                         });
       if (touched_shape)
       {
         touched = true;
@@ -612,16 +574,23 @@ private:
       box.min().array() -= thickness;
       box.max().array() += thickness;
     }
-    const double widest = model.contact_radius.maxCoeff();
-    shape_boxes_.resize(shapes_.size());
+    boxShapes(features_now_, start_features_, model.contact_radius.maxCoeff(), shape_boxes_);
+  }
+
+  /// Each shape's box around its features `now` and `then` (in the scene frame), widened by their radii and
+  /// `widen` [m].
+  void boxShapes(const std::vector<std::vector<ShapeFeature>>& now, const std::vector<std::vector<ShapeFeature>>& then,
+                 double widen, std::vector<Eigen::AlignedBox3d>& boxes) const
+  {
+    boxes.resize(shapes_.size());
     for (std::size_t k = 0; k < shapes_.size(); ++k)
     {
-      Eigen::AlignedBox3d& box = shape_boxes_[k];
+      Eigen::AlignedBox3d& box = boxes[k];
       box.setEmpty();
       for (std::size_t f = 0; f < features_[k].size(); ++f)
       {
-        const double reach = features_[k][f].radius + widest;
-        for (const ShapeFeature* feature : { &features_now_[k][f], &start_features_[k][f] })
+        const double reach = features_[k][f].radius + widen;
+        for (const ShapeFeature* feature : { &now[k][f], &then[k][f] })
           for (const Vec3& end : { feature->a, feature->b })
           {
             box.extend(Vec3(end.array() - reach));
@@ -631,34 +600,62 @@ private:
     }
   }
 
-  /// Every shape's feature groups' centres in the scene frame now and at the sub-step's start.
-  void placeGroups(std::vector<std::vector<Vec3>>& now, std::vector<std::vector<Vec3>>& then) const
+  /// Calls touch(f) for every feature f of shape k whose group and whose own segment come within `reach` [m]
+  /// of the triangle's `ball` over the sub-step: the groups' centres and the features `now` and `then` (in
+  /// the scene frame).
+  template <typename Touch>
+  void forEachFeatureNear(std::size_t k, const TriangleBall& ball, double reach, const std::vector<Vec3>& centres_now,
+                          const std::vector<Vec3>& centres_then, const std::vector<ShapeFeature>& now,
+                          const std::vector<ShapeFeature>& then, Touch touch) const
   {
-    now.resize(shapes_.size());
-    then.resize(shapes_.size());
-    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    for (std::size_t g = 0; g < groups_[k].size(); ++g)
     {
-      now[k].clear();
-      then[k].clear();
-      for (const FeatureGroup& group : groups_[k])
-      {
-        now[k].push_back(shapes_[k].at.position + shapes_[k].at.orientation * group.centre);
-        then[k].push_back(start_positions_[k] + start_orientations_[k] * group.centre);
-      }
+      const FeatureGroup& group = groups_[k][g];
+      if (!ball.meets(centres_now[g], centres_then[g], group.radius + reach))
+        continue;
+      for (std::size_t f = group.first; f < group.last; ++f)
+        if (ball.meetsSegment(now[f], then[f], reach))
+          touch(f);
     }
   }
 
-  /// Every shape's features in the scene frame, where the shapes are now (face_contacts.h), into `placed`.
-  void placeFeatures(std::vector<std::vector<ShapeFeature>>& placed) const
+  /// Every shape's feature groups' centres in the scene frame where its velocities take it in h [s] (0: now).
+  void placeGroupCentres(std::vector<std::vector<Vec3>>& centres, double h) const
+  {
+    centres.resize(shapes_.size());
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      const auto [position, orientation] = advanced(shapes_[k].at, h);
+      centres[k].clear();
+      for (const FeatureGroup& group : groups_[k])
+        centres[k].push_back(position + orientation * group.centre);
+    }
+  }
+
+  /// Every shape's feature groups' centres in the scene frame now and at the sub-step's start.
+  void placeGroups(std::vector<std::vector<Vec3>>& now, std::vector<std::vector<Vec3>>& then) const
+  {
+    placeGroupCentres(now, 0.0);
+    then.resize(shapes_.size());
+    for (std::size_t k = 0; k < shapes_.size(); ++k)
+    {
+      then[k].clear();
+      for (const FeatureGroup& group : groups_[k])
+        then[k].push_back(start_positions_[k] + start_orientations_[k] * group.centre);
+    }
+  }
+
+  /// Every shape's features in the scene frame (face_contacts.h), where its velocities take it in h [s] (0:
+  /// where it is now), into `placed`.
+  void placeFeatures(std::vector<std::vector<ShapeFeature>>& placed, double h) const
   {
     placed.resize(shapes_.size());
     for (std::size_t k = 0; k < shapes_.size(); ++k)
     {
-      const ColliderPlacement& at = shapes_[k].at;
+      const auto [position, orientation] = advanced(shapes_[k].at, h);
       placed[k].clear();
       for (const ShapeFeature& f : features_[k])
-        placed[k].push_back({ at.position + at.orientation * f.a, at.position + at.orientation * f.b, f.radius,
-                              f.flat_ends });
+        placed[k].push_back({ position + orientation * f.a, position + orientation * f.b, f.radius, f.flat_ends });
     }
   }
 
@@ -717,10 +714,10 @@ private:
   std::vector<Vec3> start_positions_;  ///< per shape: its origin at the start of the current sub-step [m]
   std::vector<Eigen::Quaterniond> start_orientations_;  ///< per shape: its orientation then
   std::vector<ReceivedImpulse> received_;  ///< per shape: from the bodies since the step began
-  /// appendFaceContacts' features at the sub-step's start and end, its feature groups' centres (end,
-  /// start) and its shapes' boxes over both
+  /// appendFaceContacts' features and their groups' centres at the sub-step's start and end, and its shapes'
+  /// boxes over both
   mutable std::vector<std::vector<ShapeFeature>> query_start_, query_end_;
-  mutable std::vector<std::vector<std::pair<Vec3, Vec3>>> query_groups_;
+  mutable std::vector<std::vector<Vec3>> query_centres_start_, query_centres_end_;
   mutable std::vector<Eigen::AlignedBox3d> query_boxes_;
 };
 
