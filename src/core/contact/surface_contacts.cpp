@@ -234,6 +234,7 @@ void SurfaceContacts::find(const Model& model, const NodeArray& x, const NodeArr
   for (std::size_t i = 0; i < solids_.size(); ++i)
     for (std::size_t e = edges_first_[i]; e < edges_first_[i + 1]; ++e)
       fold_[e] = finite(i) && isFold(model, x, solids_[i], edges_[e]);
+  outward_found_.assign(solids_.size(), 0);
   // Two solids' edges, those of each in the other's box.
   for (std::size_t i = 0; i < solids_.size(); ++i)
     for (std::size_t j = i + 1; j < solids_.size(); ++j)
@@ -278,13 +279,15 @@ void SurfaceContacts::touchThin(const Model& model, const NodeArray& x, const No
   edgesIn(solids_.size() + k, x, predicted, low_[i], high_[i], near_second_);
   if (near_second_.empty())
     return;
-  if (!thin.triangles)
+  if (!thin.triangles && !outward_found_[i])
   {
     // Against segments only the solid's nodes on a fold (a rim's, a corner's: where a segment's chord can
     // cut in between the segment's nodes; on a flat face the segment's nodes meet the face), each with its
-    // outward direction (its triangles' normals summed).
+    // outward direction (its triangles' normals summed): found once per find, for every rope near it.
+    outward_found_[i] = 1;
     outward_.resize(3, model.nodeCount());
-    on_fold_.assign(static_cast<std::size_t>(model.nodeCount()), false);
+    on_fold_.resize(static_cast<std::size_t>(model.nodeCount()));
+    std::fill_n(on_fold_.begin() + solid.first, solid.count, false);
     outward_.middleCols(solid.first, solid.count).setZero();
     for (const std::array<int, 3>& t : solid.surface)
     {

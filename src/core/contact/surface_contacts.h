@@ -171,8 +171,9 @@ private:
   /// edge inside a flat face meets no edge: the other body's nodes meet that face)
   std::vector<bool> fold_;
   std::vector<std::size_t> near_triangles_;  ///< touchThin's triangles in the solid's box
-  NodeArray outward_;                        ///< touchThin's outward directions of the solid's nodes
-  std::vector<bool> on_fold_;                ///< touchThin's: per node, on a fold of the solid
+  NodeArray outward_;                        ///< touchThin's outward directions of the solids' nodes
+  std::vector<bool> on_fold_;                ///< touchThin's: per node, on a fold of its solid
+  std::vector<char> outward_found_;          ///< per solid: outward_ and on_fold_ found in this find
   std::vector<Vec3> low_, high_;     ///< find's boxes around the solids (per entry of solids_)
   std::vector<NearEdge> near_first_, near_second_;  ///< find's edges in the other body's box
 };
