@@ -55,6 +55,20 @@ std::optional<Vec3> frictionChange(const Vec3& relative, const Vec3& n, double f
   return -(taken / length) * tangential;
 }
 
+/// Sorts `items`, found grouped by `group` in ascending order (a search's pairs by their first item), by
+/// `within` inside each group: the order of (group, within), at the cost of sorting the small groups.
+template <typename Item, typename Group, typename Within>
+void sortWithinRuns(std::vector<Item>& items, Group group, Within within)
+{
+  for (auto run = items.begin(); run != items.end();)
+  {
+    const auto key = group(*run);
+    const auto end = std::find_if(run, items.end(), [&](const Item& item) { return group(item) != key; });
+    std::sort(run, end, [&](const Item& a, const Item& b) { return within(a) < within(b); });
+    run = end;
+  }
+}
+
 /// A cell coordinate, kept far from the integer limits (a node at 1e300 m is a diverged one the guard
 /// deals with; here it only has to stay a valid index).
 std::int32_t cellCoordinate(double position, double cell)
@@ -219,7 +233,6 @@ void SelfContacts::findCandidates(const NodeArray& x)
   // within the longest link and that: the cells' width.
   grid_.build(x, segments_, longest + 4.0 * largest_radius_ + skin_ + 1e-9);
   candidates_.clear();
-  candidate_distance_.clear();
   grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
@@ -258,9 +271,10 @@ void SelfContacts::findCandidates(const NodeArray& x)
     if (same_body && by_faces &&
         contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
       return;
-    candidates_.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
-    candidate_distance_.push_back(leastDistance(x, segments_[s], segments_[t]));
+    candidates_.push_back(
+        { static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t), leastDistance(x, segments_[s], segments_[t]) });
   });
+  sortWithinRuns(candidates_, [](const Candidate& c) { return c.s; }, [](const Candidate& c) { return c.t; });
   findFaceCandidates(x);
   found_at_ = x;
   moved_.assign(static_cast<std::size_t>(x.cols()), 0.0);
@@ -311,6 +325,7 @@ void SelfContacts::findFaceCandidates(const NodeArray& x)
     }
     face_candidates_.emplace_back(static_cast<std::uint32_t>(node), static_cast<std::uint32_t>(f));
   });
+  sortWithinRuns(face_candidates_, [](const auto& c) { return c.first; }, [](const auto& c) { return c.second; });
 }
 
 bool SelfContacts::resolve(const Model& model, State& state)
@@ -346,16 +361,16 @@ bool SelfContacts::resolve(const Model& model, State& state)
   const auto moved = [&](const std::pair<int, int>& segment) {
     return std::max(moved_[static_cast<std::size_t>(segment.first)], moved_[static_cast<std::size_t>(segment.second)]);
   };
-  for (std::size_t c = 0; c < candidates_.size(); ++c)
+  for (const Candidate& candidate : candidates_)
   {
-    const auto [s, t] = candidates_[c];
+    const std::uint32_t s = candidate.s, t = candidate.t;
     const double touching = 2.0 * (radius_[s] + radius_[t]);
     // Their points have moved, relative to the mean motion (which changes no distance), no farther than
     // their farthest node: a pair whose least distance was more than that beyond the contact distance is
     // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
     // sub-step until the list is found again). A hair's margin keeps the rounding of the bound on the safe
     // side.
-    if (candidate_distance_[c] - moved(segments_[s]) - moved(segments_[t]) > touching * (1.0 + 1e-9) + 1e-12)
+    if (candidate.distance - moved(segments_[s]) - moved(segments_[t]) > touching * (1.0 + 1e-9) + 1e-12)
       continue;
     NearPair pair{ s, t, 0.0, 0.0 };
     pair.valid = contact(s, t, pair.contact);

@@ -155,8 +155,15 @@ private:
   NodeArray middle_;                           ///< per segment: its midpoint when candidates are found [m]
   std::vector<double> half_;                   ///< per segment: half its length then [m]
   SegmentGrid grid_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> candidates_;  ///< pairs that may touch
-  std::vector<double> candidate_distance_;     ///< per candidate: the links' least distance when found [m]
+  /// A pair of links that may touch, and their least distance when found [m].
+  struct Candidate
+  {
+    std::uint32_t s, t;  ///< segment indices, s < t
+    double distance;
+  };
+  /// The pairs that may touch, ordered by s and then t: the order the passes take the touching ones in,
+  /// whatever the search (its grid, its skin) or how often it runs, so that none of that changes a bit.
+  std::vector<Candidate> candidates_;
   NodeArray found_at_;                         ///< positions when the candidates were found [m]
   /// per node (global index): how far it has moved since the candidates were found, relative to the
   /// colliding nodes' mean motion [m] (candidatesHold)
@@ -194,7 +201,8 @@ private:
   /// face_grid_'s items: each of nodes_ as (n, n), then each face's first edge
   std::vector<std::pair<int, int>> face_items_;
   SegmentGrid face_grid_;
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> face_candidates_;  ///< (node, face) that may touch
+  /// (node, face) pairs that may touch, ordered by node and then face (as candidates_)
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> face_candidates_;
   /// A node over a face this sub-step: the side it started on, and what the passes gave (as NearPair).
   struct NearFace
   {
