@@ -78,32 +78,36 @@ double segmentDistance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec
   return std::min({ distance(0.0), distance(1.0), at_left, at_right });
 }
 
-// 1000 random segments up to 5 cm long in a 0.5 m box: every pair within 1 cm of each other (all pairs,
-// brute force) is among those the grid visits, and the grid visits each pair at most once.
-TEST(SegmentGrid, VisitsEveryPairWithinReachOnce)
+// 1000 random segments up to 5 cm long in a 0.5 m box, each as a ball about its midpoint through its
+// ends: every pair within 1 cm of each other (all pairs, brute force) is among those the grid visits, each
+// visited at most once and in ascending order of its first; and every segment within 1 cm of a point is
+// among those visited about it.
+TEST(BallGrid, VisitsEveryPairAndEveryBallWithinReachOnce)
 {
   std::mt19937 random(7);
   std::uniform_real_distribution<double> box(0.0, 0.5), offset(-0.025, 0.025);
   const int count = 1000;
-  NodeArray x(3, 2 * count);
-  std::vector<std::pair<int, int>> segments;
+  NodeArray x(3, 2 * count), middle(3, count);
+  std::vector<double> half(count);
   for (int s = 0; s < count; ++s)
   {
     x.col(2 * s) = Vec3(box(random), box(random), box(random));
     x.col(2 * s + 1) = x.col(2 * s) + Vec3(offset(random), offset(random), offset(random));
-    segments.emplace_back(2 * s, 2 * s + 1);
+    middle.col(s) = 0.5 * (x.col(2 * s) + x.col(2 * s + 1));
+    half[static_cast<std::size_t>(s)] = 0.5 * (x.col(2 * s) - x.col(2 * s + 1)).norm();
   }
   const double reach = 0.01;
-  double longest = 0.0;
-  for (const auto& [a, b] : segments)
-    longest = std::max(longest, (x.col(a) - x.col(b)).norm());
-  SegmentGrid grid;
-  grid.build(x, segments, longest + reach);
+  const double longest = 2.0 * *std::max_element(half.begin(), half.end());
+  BallGrid grid;
+  grid.build(middle, half, longest + reach);
   std::set<std::pair<std::size_t, std::size_t>> visited;
   int repeats = 0;
-  grid.forEachNearPair([&](std::size_t s, std::size_t t) {
+  std::size_t last_first = 0;
+  grid.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
     repeats += visited.insert({ s, t }).second ? 0 : 1;
     EXPECT_LT(s, t);
+    EXPECT_GE(s, last_first);
+    last_first = s;
   });
   EXPECT_EQ(repeats, 0);
   int within = 0;
@@ -118,15 +122,33 @@ TEST(SegmentGrid, VisitsEveryPairWithinReachOnce)
   EXPECT_GT(within, 50);  // the scene has such pairs to miss
   RecordProperty("pairs_within_reach", within);
   RecordProperty("pairs_visited", static_cast<int>(visited.size()));
+  int near_points = 0;
+  for (int k = 0; k < 200; ++k)
+  {
+    const Vec3 point(box(random), box(random), box(random));
+    std::set<std::size_t> around;
+    grid.forEachNear(point, 0.0, reach, [&](std::size_t t) { EXPECT_TRUE(around.insert(t).second) << t; });
+    for (int t = 0; t < count; ++t)
+      if (segmentDistance(point, point, x.col(2 * t), x.col(2 * t + 1)) <= reach)
+      {
+        ++near_points;
+        EXPECT_TRUE(around.count(static_cast<std::size_t>(t))) << "segment " << t << " missed near point " << k;
+      }
+  }
+  EXPECT_GT(near_points, 10);
 }
 
 // The Verlet list's rule: two cloths of 10 x 10 nodes (2.5 cm apart, 1 cm thick, self-colliding), one
 // 1.5 cm above the other, so that every node of the upper one touches the lower one (contact distance
 // 2 cm). Carried together by 1.5 cm at a time, more than half the skin of 2 thicknesses each time, the
 // list found at the start holds (one search in 40 moves), and each resolution equals that of a fresh
-// search at the moved positions to round-off. A node moved 3 cm relative to the others makes it search
-// again.
-TEST(SelfContacts, CandidatesHoldWhileEverythingMovesTogetherAndEqualAFreshSearch)
+// search at the moved positions bit for bit (the pairs are taken in an order no search changes). A node
+// moved 3 cm relative to the others makes it search again. By the cloths' nodes as balls, and by their
+// triangles' edges and faces.
+class CandidateList : public ::testing::TestWithParam<bool>
+{
+};
+TEST_P(CandidateList, HoldsWhileEverythingMovesTogetherAndEqualsAFreshSearch)
 {
   SceneDef scene = xpbdScene(-1.0);
   for (const double height : { 0.0, 0.015 })
@@ -137,6 +159,7 @@ TEST(SelfContacts, CandidatesHoldWhileEverythingMovesTogetherAndEqualAFreshSearc
     cloth.corners = GridCorners{ Vec3(0, 0, height), Vec3(0.225, 0, height), Vec3(0, 0.225, height) };
     cloth.thickness = 0.01;
     cloth.self_collision = true;
+    cloth.face_contacts = GetParam();
     scene.bodies.push_back(buildCloth(height > 0.0 ? "upper" : "lower", cloth));
   }
   const World world = buildWorld(scene);
@@ -150,17 +173,22 @@ TEST(SelfContacts, CandidatesHoldWhileEverythingMovesTogetherAndEqualAFreshSearc
     moved.position.colwise() += static_cast<double>(k) * step;
     State fresh_moved = moved;
     SelfContacts fresh(model, rest.position);
+    carried.remember(moved);  // as a sub-step does before its integration: where a face's nodes start
+    fresh.remember(fresh_moved);
     EXPECT_TRUE(carried.resolve(model, moved));
     EXPECT_TRUE(fresh.resolve(model, fresh_moved));
-    EXPECT_LT((moved.position - fresh_moved.position).cwiseAbs().maxCoeff(), 1e-12) << "move " << k;
-    EXPECT_LT((moved.velocity - fresh_moved.velocity).cwiseAbs().maxCoeff(), 1e-12) << "move " << k;
+    EXPECT_TRUE((moved.position.array() == fresh_moved.position.array()).all()) << "move " << k;
+    EXPECT_TRUE((moved.velocity.array() == fresh_moved.velocity.array()).all()) << "move " << k;
   }
   EXPECT_EQ(carried.searches(), 1u);
   State apart = rest;
   apart.position.col(150) += Vec3(0.0, 0.0, 0.03);
+  carried.remember(apart);
   carried.resolve(model, apart);
   EXPECT_EQ(carried.searches(), 2u);
 }
+INSTANTIATE_TEST_SUITE_P(Cloths, CandidateList, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& info) { return info.param ? "by_faces" : "by_nodes"; });
 
 /// A 3 m rope of radius 5 mm (121 nodes, 2.5 cm links) in a loose coil: a helix of radius 0.1 m and
 /// 2 cm pitch, from 0.29 m above the floor down, dropped onto the floor (friction 0.5). xpbd at 1/60 s

@@ -69,36 +69,59 @@ void sortWithinRuns(std::vector<Item>& items, Group group, Within within)
   }
 }
 
-/// A cell coordinate, kept far from the integer limits (a node at 1e300 m is a diverged one the guard
-/// deals with; here it only has to stay a valid index).
-std::int32_t cellCoordinate(double position, double cell)
-{
-  return static_cast<std::int32_t>(std::clamp(std::floor(position / cell), -1e9, 1e9));
-}
 }  // namespace
 
-std::int64_t SegmentGrid::slot(std::int64_t i, std::int64_t j, std::int64_t k) const
+std::int32_t BallGrid::coordinate(double position) const
+{
+  // Kept far from the integer limits (a node at 1e300 m is a diverged one the guard deals with; here it
+  // only has to stay a valid index).
+  return static_cast<std::int32_t>(std::clamp(std::floor(position / cell_), -1e9, 1e9));
+}
+
+std::int64_t BallGrid::slot(std::int64_t i, std::int64_t j, std::int64_t k) const
 {
   const std::uint64_t hash = (static_cast<std::uint64_t>(i) * 73856093u) ^ (static_cast<std::uint64_t>(j) * 19349663u) ^
                              (static_cast<std::uint64_t>(k) * 83492791u);
   return static_cast<std::int64_t>(hash & (start_.size() - 2));  // the slot count is a power of two
 }
 
-void SegmentGrid::build(const NodeArray& x, const std::vector<std::pair<int, int>>& segments, double cell)
+int BallGrid::slotsAround(const std::int32_t* c, std::int64_t* slots) const
 {
-  const std::size_t count = segments.size();
-  std::size_t slots = 1;  // a power of two, at least twice the segments: a mask, not a division, per lookup
+  int count = 0;
+  for (int di = -1; di <= 1; ++di)
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int dk = -1; dk <= 1; ++dk)
+      {
+        const std::int64_t slot_index = slot(c[0] + di, c[1] + dj, c[2] + dk);
+        const std::size_t slot_u = static_cast<std::size_t>(slot_index);
+        if (start_[slot_u] == start_[slot_u + 1])
+          continue;  // empty: most of them, and nothing to tell apart
+        if (std::find(slots, slots + count, slot_index) == slots + count)
+          slots[count++] = slot_index;
+      }
+  return count;
+}
+
+void BallGrid::build(const NodeArray& centre, const std::vector<double>& radius, double cell)
+{
+  cell_ = cell;
+  const std::size_t count = radius.size();
+  std::size_t slots = 1;  // a power of two, at least twice the balls: a mask, not a division, per lookup
   while (slots < 2 * count)
     slots *= 2;
   coordinate_.resize(3 * count);
   slot_of_.resize(count);
+  place_.resize(count);
   sorted_.resize(count);
+  x_.resize(count);
+  y_.resize(count);
+  z_.resize(count);
+  r_.resize(count);
   start_.assign(slots + 1, 0);
   for (std::size_t s = 0; s < count; ++s)
   {
-    const Vec3 middle = 0.5 * (x.col(segments[s].first) + x.col(segments[s].second));
     for (int axis = 0; axis < 3; ++axis)
-      coordinate_[3 * s + static_cast<std::size_t>(axis)] = cellCoordinate(middle[axis], cell);
+      coordinate_[3 * s + static_cast<std::size_t>(axis)] = coordinate(centre(axis, static_cast<Eigen::Index>(s)));
     const std::int32_t* c = &coordinate_[3 * s];
     slot_of_[s] = static_cast<std::uint32_t>(slot(c[0], c[1], c[2]));
     ++start_[slot_of_[s] + 1];
@@ -107,7 +130,15 @@ void SegmentGrid::build(const NodeArray& x, const std::vector<std::pair<int, int
     start_[q + 1] += start_[q];
   cursor_.assign(start_.begin(), start_.end() - 1);
   for (std::size_t s = 0; s < count; ++s)
-    sorted_[cursor_[slot_of_[s]]++] = static_cast<std::uint32_t>(s);
+  {
+    const std::uint32_t e = cursor_[slot_of_[s]]++;
+    place_[s] = e;
+    sorted_[e] = static_cast<std::uint32_t>(s);
+    x_[e] = centre(0, static_cast<Eigen::Index>(s));
+    y_[e] = centre(1, static_cast<Eigen::Index>(s));
+    z_[e] = centre(2, static_cast<Eigen::Index>(s));
+    r_[e] = radius[s];
+  }
 }
 
 SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
@@ -181,14 +212,14 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   skin_ = kSkinRadii * largest_radius_;
   if (faces_.empty())
     return;
+  findRestNeighbours();
   for (const int node : nodes_)
   {
-    face_items_.emplace_back(node, node);
     node_radius_.push_back(model.contact_radius[node]);
     node_body_.push_back(static_cast<int>(model.bodyOf(node)));
   }
-  for (const std::array<int, 3>& face : faces_)
-    face_items_.emplace_back(face[0], face[1]);
+  face_centre_.setZero(3, static_cast<Eigen::Index>(faces_.size()));
+  face_extent_.assign(faces_.size(), 0.0);
 }
 
 void SelfContacts::remember(const State& state)
@@ -229,11 +260,21 @@ void SelfContacts::findCandidates(const NodeArray& x)
     half_[s] = 0.5 * (x.col(a) - x.col(b)).norm();
     longest = std::max(longest, 2.0 * half_[s]);
   }
-  // A candidate pair's links come within twice their radii and the skin (see below), so their midpoints
-  // within the longest link and that: the cells' width.
-  grid_.build(x, segments_, longest + 4.0 * largest_radius_ + skin_ + 1e-9);
+  // A candidate pair's links come within twice their radii and the skin (see below): their balls (about
+  // their midpoints, of half their lengths) within the widest such reach.
+  const double reach = 4.0 * largest_radius_ + skin_;
+  grid_.build(middle_, half_, longest + reach + 1e-9);
   candidates_.clear();
-  grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
+  // Marks (1) or unmarks (0) segment s's later neighbours at rest, which it never touches; none for
+  // s = -1 or without face-contact cloths.
+  const auto mark = [&](std::size_t s, char value) {
+    if (s < segments_.size() && !rest_near_start_.empty())
+      for (std::uint32_t k = rest_near_start_[s]; k < rest_near_start_[s + 1]; ++k)
+        rest_near_mark_[rest_near_[k]] = value;
+  };
+  rest_near_mark_.assign(segments_.size(), 0);
+  std::size_t marked = static_cast<std::size_t>(-1);
+  grid_.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
     if (a == c || a == d || b == c || b == d)
@@ -242,8 +283,15 @@ void SelfContacts::findCandidates(const NodeArray& x)
     // diagonals) and only its nodes stay out of them; a cloth's (or jelly's) nodes within twice their
     // contact distance at rest (its direct and diagonal neighbours) are held apart by its springs, and come
     // that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute Physics). A
-    // face-contact cloth's edges likewise: those within twice their contact distance at rest (below, once
-    // the pair is near: the test at rest is the dearer one).
+    // face-contact cloth's edges likewise (rest_near_, marked for s).
+    if (marked != s)
+    {
+      mark(marked, 0);
+      mark(s, 1);
+      marked = s;
+    }
+    if (rest_near_mark_[t] != 0)
+      return;
     const bool same_body = body_[s] == body_[t];
     const bool by_faces = by_faces_[static_cast<std::size_t>(body_[s])];
     if (same_body && !by_faces)
@@ -260,20 +308,18 @@ void SelfContacts::findCandidates(const NodeArray& x)
       }
     }
     const double within = 2.0 * (radius_[s] + radius_[t]) + skin_;
-    // Bounding balls first: most pairs in neighbouring cells are farther apart than that.
+    // Their balls within their own reach (the grid's is the widest pair's).
     const double bound = half_[s] + half_[t] + within;
     if ((middle_.col(static_cast<Eigen::Index>(s)) - middle_.col(static_cast<Eigen::Index>(t))).squaredNorm() >
         bound * bound)
       return;
-    double p, q;
-    if (!(contactGap(x, segments_[s], segments_[t], p, q).norm() < within))
+    // By their least distance, which the contact's (contactGap's) never undercuts.
+    const double distance = leastDistance(x, segments_[s], segments_[t]);
+    if (!(distance < within))
       return;
-    if (same_body && by_faces &&
-        contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
-      return;
-    candidates_.push_back(
-        { static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t), leastDistance(x, segments_[s], segments_[t]) });
+    candidates_.push_back({ static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t), distance });
   });
+  mark(marked, 0);
   sortWithinRuns(candidates_, [](const Candidate& c) { return c.s; }, [](const Candidate& c) { return c.t; });
   findFaceCandidates(x);
   found_at_ = x;
@@ -281,50 +327,77 @@ void SelfContacts::findCandidates(const NodeArray& x)
   ++searches_;
 }
 
+void SelfContacts::findRestNeighbours()
+{
+  double longest = 0.0;
+  for (std::size_t s = 0; s < segments_.size(); ++s)
+  {
+    const auto [a, b] = segments_[s];
+    middle_.col(static_cast<Eigen::Index>(s)) = 0.5 * (rest_.col(a) + rest_.col(b));
+    half_[s] = 0.5 * (rest_.col(a) - rest_.col(b)).norm();
+    longest = std::max(longest, 2.0 * half_[s]);
+  }
+  const double reach = 4.0 * largest_radius_;
+  grid_.build(middle_, half_, longest + reach + 1e-9);
+  rest_near_start_.assign(segments_.size() + 1, 0);
+  rest_near_.clear();
+  grid_.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
+    const auto [a, b] = segments_[s];
+    const auto [c, d] = segments_[t];
+    if (a == c || a == d || b == c || b == d || body_[s] != body_[t] ||
+        !by_faces_[static_cast<std::size_t>(body_[s])])
+      return;
+    double p, q;
+    if (contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))
+    {
+      rest_near_.push_back(static_cast<std::uint32_t>(t));
+      ++rest_near_start_[s + 1];
+    }
+  });
+  for (std::size_t s = 0; s < segments_.size(); ++s)
+    rest_near_start_[s + 1] += rest_near_start_[s];
+}
+
 void SelfContacts::findFaceCandidates(const NodeArray& x)
 {
   face_candidates_.clear();
   if (faces_.empty())
     return;
-  // A face lies within its longest edge of its first edge's midpoint (the item's place in the grid), a
-  // node at its own: a node and a face within their radii and the skin sit in the same or neighbouring
-  // cells of that width plus the radii and the skin.
-  double longest = 0.0, thickest = 0.0;
+  // Each face as a ball about its centroid, through its farthest corner; a node within its radius, the
+  // face's thickness and the skin of the face lies within that of the ball.
+  double widest_face = 0.0, thickest = 0.0;
   for (std::size_t f = 0; f < faces_.size(); ++f)
   {
-    for (int k = 0; k < 3; ++k)
-      longest = std::max(longest, (x.col(faces_[f][k]) - x.col(faces_[f][(k + 1) % 3])).norm());
+    const Vec3 centroid = (x.col(faces_[f][0]) + x.col(faces_[f][1]) + x.col(faces_[f][2])) / 3.0;
+    face_centre_.col(static_cast<Eigen::Index>(f)) = centroid;
+    face_extent_[f] = 0.0;
+    for (const int corner : faces_[f])
+      face_extent_[f] = std::max(face_extent_[f], (x.col(corner) - centroid).norm());
+    widest_face = std::max(widest_face, face_extent_[f]);
     thickest = std::max(thickest, face_radius_[f]);
   }
-  const double widest = *std::max_element(node_radius_.begin(), node_radius_.end());
-  face_grid_.build(x, face_items_, longest + widest + thickest + skin_ + 1e-9);
-  const std::size_t node_count = nodes_.size();
-  face_grid_.forEachNearPair([&](std::size_t s, std::size_t t) {
-    if (!(s < node_count && t >= node_count))
-      return;  // two nodes or two faces: the segments' pairs
-    const int node = nodes_[s];
-    const std::size_t f = t - node_count;
-    const std::array<int, 3>& face = faces_[f];
-    if (node == face[0] || node == face[1] || node == face[2])
-      return;
-    const double reach = node_radius_[s] + face_radius_[f];
-    // Bounding balls first (the face's about its first corner, of its two edges from there).
-    const Vec3 p = x.col(node), a = x.col(face[0]);
-    const double bound = std::max((x.col(face[1]) - a).norm(), (x.col(face[2]) - a).norm()) + reach + skin_;
-    if ((p - a).squaredNorm() > bound * bound)
-      return;
-    if (!((p - nearestOnTriangle(p, a, x.col(face[1]), x.col(face[2])).point).norm() < reach + skin_))
-      return;
-    // A cloth's own node near the face at rest (a corner of the next triangle) is held off by its springs.
-    if (node_body_[s] == face_body_[f])
-    {
-      const Vec3 at_rest = rest_.col(node);
-      if ((at_rest - nearestOnTriangle(at_rest, rest_.col(face[0]), rest_.col(face[1]), rest_.col(face[2])).point)
-              .norm() < 2.0 * reach)
+  const double reach = *std::max_element(node_radius_.begin(), node_radius_.end()) + thickest + skin_;
+  face_grid_.build(face_centre_, face_extent_, widest_face + reach + 1e-9);
+  for (std::size_t s = 0; s < nodes_.size(); ++s)
+    face_grid_.forEachNear(x.col(nodes_[s]), 0.0, reach, [&](std::size_t f) {
+      const int node = nodes_[s];
+      const std::array<int, 3>& face = faces_[f];
+      if (node == face[0] || node == face[1] || node == face[2])
         return;
-    }
-    face_candidates_.emplace_back(static_cast<std::uint32_t>(node), static_cast<std::uint32_t>(f));
-  });
+      const double touch = node_radius_[s] + face_radius_[f];
+      const Vec3 p = x.col(node);
+      if (!((p - nearestOnTriangle(p, x.col(face[0]), x.col(face[1]), x.col(face[2])).point).norm() < touch + skin_))
+        return;
+      // A cloth's own node near the face at rest (a corner of the next triangle) is held off by its springs.
+      if (node_body_[s] == face_body_[f])
+      {
+        const Vec3 at_rest = rest_.col(node);
+        if ((at_rest - nearestOnTriangle(at_rest, rest_.col(face[0]), rest_.col(face[1]), rest_.col(face[2])).point)
+                .norm() < 2.0 * touch)
+          return;
+      }
+      face_candidates_.emplace_back(static_cast<std::uint32_t>(node), static_cast<std::uint32_t>(f));
+    });
   sortWithinRuns(face_candidates_, [](const auto& c) { return c.first; }, [](const auto& c) { return c.second; });
 }
 

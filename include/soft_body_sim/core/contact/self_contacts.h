@@ -5,6 +5,7 @@
 // body asks has no pass here and pays nothing.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <utility>
@@ -15,60 +16,91 @@
 namespace soft_body_sim
 {
 /// A uniform grid hashed into a table (a spatial hash, Teschner et al. 2003, "Optimized Spatial Hashing
-/// for Collision Detection of Deformable Objects"), over segments: each segment sits in the cell of its
-/// midpoint, and with cells at least as wide as the longest segment plus the two largest radii, two
-/// segments that come within their radii of each other sit in the same or neighbouring cells. Built by a
-/// counting sort each time: no allocation once its arrays have grown to the segment count.
-class SegmentGrid
+/// for Collision Detection of Deformable Objects"), over balls: a segment's midpoint and half length, a
+/// face's centroid and its farthest corner from it. With cells at least as wide as the two largest radii
+/// and the widest gap asked about, two balls within that gap of each other sit in the same or neighbouring
+/// cells. Built by a counting sort each time, the balls copied in the cells' order so that a cell's are
+/// read one after the other: no allocation once its arrays have grown to the ball count.
+class BallGrid
 {
 public:
-  /// Sorts `segments` (node index pairs into `x`) into cells of width `cell` [m] (> 0).
-  void build(const NodeArray& x, const std::vector<std::pair<int, int>>& segments, double cell);
+  /// Sorts the balls (`centre` [m], one per column, and `radius` [m]) into cells of width `cell` [m] (> 0).
+  void build(const NodeArray& centre, const std::vector<double>& radius, double cell);
 
-  /// Calls visit(s, t) once for every pair s < t of segments in the same or neighbouring cells (and some
-  /// more, whose cells share a slot of the table): a superset of the pairs within `cell` of each other.
+  /// Calls visit(s, t) for every pair s < t of balls closer than `gap` [m] to each other (their centres
+  /// closer than their radii and the gap, which must not exceed the cell's width less the two largest
+  /// radii), s ascending.
   template <typename Visit>
-  void forEachNearPair(Visit visit) const;
+  void forEachNearPair(double gap, Visit visit) const;
+
+  /// Calls visit(t) for every ball closer than `gap` [m] to a ball at `centre` [m] of `radius` [m] (radius,
+  /// gap and the largest radius together within the cell's width).
+  template <typename Visit>
+  void forEachNear(const Vec3& centre, double radius, double gap, Visit visit) const;
 
 private:
   std::int64_t slot(std::int64_t i, std::int64_t j, std::int64_t k) const;
+  std::int32_t coordinate(double position) const;
+  /// The distinct non-empty slots of the 27 cells around (i, j, k) (two cells may share a slot); their count.
+  int slotsAround(const std::int32_t* c, std::int64_t* slots) const;
+  /// Calls visit(t) for every ball t of the slots around `c` closer than `gap` to the ball (p, r) with
+  /// t > after (after = -1: all).
+  template <typename Visit>
+  void visitAround(const std::int32_t* c, const Vec3& p, double r, double gap, std::int64_t after, Visit visit) const;
 
-  std::vector<std::int32_t> coordinate_;  ///< per segment: its cell's i, j, k
-  std::vector<std::uint32_t> start_;      ///< per slot: where its segments begin in sorted_
-  std::vector<std::uint32_t> sorted_;     ///< segment indices sorted by slot
-  std::vector<std::uint32_t> slot_of_;    ///< per segment: its slot
+  double cell_ = 1.0;                     ///< [m]
+  std::vector<std::int32_t> coordinate_;  ///< per ball: its cell's i, j, k
+  std::vector<std::uint32_t> start_;      ///< per slot: where its balls begin in the sorted arrays
+  std::vector<std::uint32_t> slot_of_;    ///< per ball: its slot
   std::vector<std::uint32_t> cursor_;     ///< per slot: the next free place while sorting
+  std::vector<std::uint32_t> place_;      ///< per ball: its place in the sorted arrays
+  /// the balls in slot order: index, centre [m] and radius [m]
+  std::vector<std::uint32_t> sorted_;
+  std::vector<double> x_, y_, z_, r_;
 };
 
 template <typename Visit>
-void SegmentGrid::forEachNearPair(Visit visit) const
+void BallGrid::visitAround(const std::int32_t* c, const Vec3& p, double r, double gap, std::int64_t after,
+                           Visit visit) const
+{
+  std::int64_t slots[27];
+  const int count = slotsAround(c, slots);
+  for (int q = 0; q < count; ++q)
+  {
+    const std::size_t slot_u = static_cast<std::size_t>(slots[q]);
+    // A slot's balls are in ascending order (build's counting sort): those after `after` are a tail.
+    const std::uint32_t* first = sorted_.data() + start_[slot_u];
+    const std::uint32_t* last = sorted_.data() + start_[slot_u + 1];
+    if (after >= 0)
+      first = std::upper_bound(first, last, static_cast<std::uint32_t>(after));
+    for (std::size_t e = static_cast<std::size_t>(first - sorted_.data()); e < start_[slot_u + 1]; ++e)
+    {
+      const double reach = r + r_[e] + gap;
+      const double dx = x_[e] - p.x(), dy = y_[e] - p.y(), dz = z_[e] - p.z();
+      if (dx * dx + dy * dy + dz * dz < reach * reach)
+        visit(static_cast<std::size_t>(sorted_[e]));
+    }
+  }
+}
+
+template <typename Visit>
+void BallGrid::forEachNearPair(double gap, Visit visit) const
 {
   const std::size_t count = slot_of_.size();
+  // The balls in their own order (s ascending), each read from the sorted arrays through its slot.
   for (std::size_t s = 0; s < count; ++s)
   {
-    const std::int32_t* c = &coordinate_[3 * s];
-    // The 27 cells around s's, each non-empty slot looked at once even if two of them share it.
-    std::int64_t seen[27];
-    int seen_count = 0;
-    for (int di = -1; di <= 1; ++di)
-      for (int dj = -1; dj <= 1; ++dj)
-        for (int dk = -1; dk <= 1; ++dk)
-        {
-          const std::int64_t slot_index = slot(c[0] + di, c[1] + dj, c[2] + dk);
-          const std::size_t slot_u = static_cast<std::size_t>(slot_index);
-          if (start_[slot_u] == start_[slot_u + 1])
-            continue;  // empty: most of them, and nothing to tell apart
-          bool repeated = false;
-          for (int q = 0; q < seen_count; ++q)
-            repeated = repeated || seen[q] == slot_index;
-          if (repeated)
-            continue;
-          seen[seen_count++] = slot_index;
-          for (std::uint32_t e = start_[slot_u]; e < start_[slot_u + 1]; ++e)
-            if (sorted_[e] > s)
-              visit(s, static_cast<std::size_t>(sorted_[e]));
-        }
+    const std::uint32_t e = place_[s];
+    visitAround(&coordinate_[3 * s], Vec3(x_[e], y_[e], z_[e]), r_[e], gap, static_cast<std::int64_t>(s),
+                [&](std::size_t t) { visit(s, t); });
   }
+}
+
+template <typename Visit>
+void BallGrid::forEachNear(const Vec3& centre, double radius, double gap, Visit visit) const
+{
+  const std::int32_t c[3] = { coordinate(centre.x()), coordinate(centre.y()), coordinate(centre.z()) };
+  visitAround(c, centre, radius, gap, -1, visit);
 }
 
 /// Segment-against-segment contact of the bodies with `self_collision` (BodyRange); a body without links
@@ -123,7 +155,10 @@ private:
   /// The pairs within twice their radii and the skin, through the spatial hash.
   void findCandidates(const NodeArray& x);
 
-  /// The node-face pairs within the radii and the skin (nodes_ and faces_ through face_grid_).
+  /// A face-contact cloth's pairs of edges near each other at rest (their contact within twice their
+  /// radii there: neighbours its springs hold apart), into rest_near_.
+  void findRestNeighbours();
+  /// The node-face pairs within the radii and the skin (each of nodes_ against faces_ through face_grid_).
   void findFaceCandidates(const NodeArray& x);
   /// A node's place over a face now: its weights there, the face's unit normal towards the side the node
   /// started on, and the node's height over the face that way [m]; false if the node is not over it.
@@ -154,7 +189,14 @@ private:
   double skin_ = 0.0;                          ///< [m]
   NodeArray middle_;                           ///< per segment: its midpoint when candidates are found [m]
   std::vector<double> half_;                   ///< per segment: half its length then [m]
-  SegmentGrid grid_;
+  BallGrid grid_;
+  /// Per segment s, the later segments t (s < t) of its face-contact cloth near it at rest, which it never
+  /// collides with (findRestNeighbours): rest_near_[rest_near_start_[s] .. rest_near_start_[s + 1]); none
+  /// without face-contact cloths.
+  std::vector<std::uint32_t> rest_near_start_, rest_near_;
+  /// per segment: 1 while the search looks at the pairs of a segment it is near at rest (a flag a pair
+  /// reads at once, in place of looking through the list)
+  std::vector<char> rest_near_mark_;
   /// A pair of links that may touch, and their least distance when found [m].
   struct Candidate
   {
@@ -198,9 +240,9 @@ private:
   std::vector<double> face_friction_;      ///< per face: its body's self_friction [-]
   std::vector<double> node_radius_;        ///< per node of nodes_: its contact radius [m]
   std::vector<int> node_body_;             ///< per node of nodes_: its body
-  /// face_grid_'s items: each of nodes_ as (n, n), then each face's first edge
-  std::vector<std::pair<int, int>> face_items_;
-  SegmentGrid face_grid_;
+  NodeArray face_centre_;                  ///< per face: its centroid when candidates are found [m]
+  std::vector<double> face_extent_;        ///< per face: its farthest corner from there [m]
+  BallGrid face_grid_;
   /// (node, face) pairs that may touch, ordered by node and then face (as candidates_)
   std::vector<std::pair<std::uint32_t, std::uint32_t>> face_candidates_;
   /// A node over a face this sub-step: the side it started on, and what the passes gave (as NearPair).
