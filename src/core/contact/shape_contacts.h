@@ -562,17 +562,19 @@ private:
     for (std::size_t t = 0; t < model.contact_triangles.size(); ++t)
     {
       const std::array<int, 3>& triangle = model.contact_triangles[t];
-      Eigen::AlignedBox3d& box = triangle_boxes_[t];
-      box.setEmpty();
-      double thickness = 0.0;
-      for (const int node : triangle)
+      // The corners' least and greatest coordinates, component by component (what AlignedBox::extend
+      // does, here inlined: this runs for every triangle, every sub-step, for each kind of shape).
+      Vec3 low = x.col(triangle[0]).cwiseMin(start.col(triangle[0]));
+      Vec3 high = x.col(triangle[0]).cwiseMax(start.col(triangle[0]));
+      double thickness = model.contact_radius[triangle[0]];
+      for (int c = 1; c < 3; ++c)
       {
-        box.extend(Vec3(x.col(node)));
-        box.extend(Vec3(start.col(node)));
+        const int node = triangle[static_cast<std::size_t>(c)];
+        low = low.cwiseMin(x.col(node)).cwiseMin(start.col(node));
+        high = high.cwiseMax(x.col(node)).cwiseMax(start.col(node));
         thickness = std::max(thickness, model.contact_radius[node]);
       }
-      box.min().array() -= thickness;
-      box.max().array() += thickness;
+      triangle_boxes_[t] = Eigen::AlignedBox3d(low.array() - thickness, high.array() + thickness);
     }
     boxShapes(features_now_, start_features_, model.contact_radius.maxCoeff(), shape_boxes_);
   }
