@@ -205,6 +205,7 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
     rest_ = rest;  // a scene without self-collision keeps no copy
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
+  rest_near_mark_.assign(segments_.size(), 0);
   for (const auto& [a, b] : segments_)
     nodes_.insert(nodes_.end(), { a, b });
   std::sort(nodes_.begin(), nodes_.end());
@@ -272,7 +273,6 @@ void SelfContacts::findCandidates(const NodeArray& x)
       for (std::uint32_t k = rest_near_start_[s]; k < rest_near_start_[s + 1]; ++k)
         rest_near_mark_[rest_near_[k]] = value;
   };
-  rest_near_mark_.assign(segments_.size(), 0);
   std::size_t marked = static_cast<std::size_t>(-1);
   grid_.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
     const auto [a, b] = segments_[s];
@@ -329,6 +329,7 @@ void SelfContacts::findCandidates(const NodeArray& x)
 
 void SelfContacts::findRestNeighbours()
 {
+  // The rest positions' midpoints and half lengths, in the arrays each search fills with the current ones.
   double longest = 0.0;
   for (std::size_t s = 0; s < segments_.size(); ++s)
   {
