@@ -579,11 +579,13 @@ TEST(JellySqueeze, UnderAFallingBoxNoNodeCrossesASpringWithSelfCollision)
             corner = std::min(corner, grid.minCornerTriangle(world.state().position, i, j) / rest_corner);
       }
       // Squeezed: the top row is pressed against the box, a contact distance t under it (self-contacts
-      // act after the colliders in a sub-step, and push the top row up to a quarter of t into the box).
+      // act after the colliders in a sub-step and push the top row into the box: how far depends on the
+      // order in which the Gauss-Seidel passes take the pairs; measured up to 0.25 t with the pairs in the
+      // grid's order, up to 0.34 t with implicit_euler and the pairs in their links' order, as now).
       double top = 0.0;
       for (int k = 0; k < nodes; ++k)
         top = std::max(top, world.state().position(2, k));
-      EXPECT_NEAR(top, 0.2 - t, 0.3 * t);
+      EXPECT_NEAR(top, 0.2 - t, 0.4 * t);
       RecordProperty(std::string(self_collision ? "least_over_2t_with_" : "least_over_2t_without_") +
                          integratorName(integrator),
                      figure(least / (2.0 * t)));
