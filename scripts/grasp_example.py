@@ -5,6 +5,8 @@ second (from ~<body>/<frame>/wrench), and lets go with ~release.
 
   rosrun soft_body_sim grasp_example.py          # on the demo: lifts the string's free end
 
+It exits 1 when the simulator has no such body or refuses the grasp.
+
 Parameters (private, all optional):
   ~simulator  namespace of the simulator's topics and services (default /soft_body_sim)
   ~frame      tf frame of the gripper, a child of ~frame_id; it names the grasp (default hand)
@@ -20,6 +22,7 @@ Parameters (private, all optional):
   ~rate       [Hz] tf broadcasts per second (default 50)
 """
 import math
+import sys
 
 import rospy
 import tf2_ros
@@ -70,7 +73,7 @@ def main():
     bodies = {b.name: b for b in latest_state[0].bodies}
     if body not in bodies:
         rospy.logfatal("grasp_example: the simulator has no body '%s' (it has %s)", body, ", ".join(bodies))
-        return
+        return 1
 
     def node_position():
         p = next(b for b in latest_state[0].bodies if b.name == body).positions[node]
@@ -91,7 +94,7 @@ def main():
             break
     if not response.success:
         rospy.logfatal("grasp_example: grasp refused: %s", response.message)
-        return
+        return 1
     start = rospy.Time.now()
 
     def broadcast(stamp):
@@ -118,7 +121,8 @@ def main():
                           (now - start).to_sec(), body, frame, f.x, f.y, f.z, math.sqrt(f.x ** 2 + f.y ** 2 + f.z ** 2))
         ticker.sleep()
     rospy.loginfo("grasp_example: %s", release(frame=frame).message)
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())
