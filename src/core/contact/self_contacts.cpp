@@ -253,18 +253,10 @@ bool SelfContacts::candidatesHold(const NodeArray& x)
 
 void SelfContacts::findCandidates(const NodeArray& x)
 {
-  double longest = 0.0;
-  for (std::size_t s = 0; s < segments_.size(); ++s)
-  {
-    const auto [a, b] = segments_[s];
-    middle_.col(static_cast<Eigen::Index>(s)) = 0.5 * (x.col(a) + x.col(b));
-    half_[s] = 0.5 * (x.col(a) - x.col(b)).norm();
-    longest = std::max(longest, 2.0 * half_[s]);
-  }
-  // A candidate pair's links come within twice their radii and the skin (see below): their balls (about
-  // their midpoints, of half their lengths) within the widest such reach.
+  // A candidate pair's links come within twice their radii and the skin (see below): their balls within
+  // the widest such reach.
   const double reach = 4.0 * largest_radius_ + skin_;
-  grid_.build(middle_, half_, longest + reach + 1e-9);
+  gridSegments(x, reach);
   candidates_.clear();
   // Marks (1) or unmarks (0) segment s's later neighbours at rest, which it never touches; none for
   // s = -1 or without face-contact cloths.
@@ -275,10 +267,10 @@ void SelfContacts::findCandidates(const NodeArray& x)
   };
   std::size_t marked = static_cast<std::size_t>(-1);
   grid_.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
+    if (shareANode(s, t))
+      return;
     const auto [a, b] = segments_[s];
     const auto [c, d] = segments_[t];
-    if (a == c || a == d || b == c || b == d)
-      return;
     // Neighbours along one rope touch at their joints; a jelly's springs cross each other at rest (a cell's
     // diagonals) and only its nodes stay out of them; a cloth's (or jelly's) nodes within twice their
     // contact distance at rest (its direct and diagonal neighbours) are held apart by its springs, and come
@@ -327,26 +319,35 @@ void SelfContacts::findCandidates(const NodeArray& x)
   ++searches_;
 }
 
-void SelfContacts::findRestNeighbours()
+void SelfContacts::gridSegments(const NodeArray& y, double reach)
 {
-  // The rest positions' midpoints and half lengths, in the arrays each search fills with the current ones.
   double longest = 0.0;
   for (std::size_t s = 0; s < segments_.size(); ++s)
   {
     const auto [a, b] = segments_[s];
-    middle_.col(static_cast<Eigen::Index>(s)) = 0.5 * (rest_.col(a) + rest_.col(b));
-    half_[s] = 0.5 * (rest_.col(a) - rest_.col(b)).norm();
+    middle_.col(static_cast<Eigen::Index>(s)) = 0.5 * (y.col(a) + y.col(b));
+    half_[s] = 0.5 * (y.col(a) - y.col(b)).norm();
     longest = std::max(longest, 2.0 * half_[s]);
   }
-  const double reach = 4.0 * largest_radius_;
   grid_.build(middle_, half_, longest + reach + 1e-9);
+}
+
+bool SelfContacts::shareANode(std::size_t s, std::size_t t) const
+{
+  const auto [a, b] = segments_[s];
+  const auto [c, d] = segments_[t];
+  return a == c || a == d || b == c || b == d;
+}
+
+void SelfContacts::findRestNeighbours()
+{
+  // At rest, in the arrays each search fills with the current positions.
+  const double reach = 4.0 * largest_radius_;
+  gridSegments(rest_, reach);
   rest_near_start_.assign(segments_.size() + 1, 0);
   rest_near_.clear();
   grid_.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
-    const auto [a, b] = segments_[s];
-    const auto [c, d] = segments_[t];
-    if (a == c || a == d || b == c || b == d || body_[s] != body_[t] ||
-        !by_faces_[static_cast<std::size_t>(body_[s])])
+    if (shareANode(s, t) || body_[s] != body_[t] || !by_faces_[static_cast<std::size_t>(body_[s])])
       return;
     double p, q;
     if (contactGap(rest_, segments_[s], segments_[t], p, q).norm() < 2.0 * (radius_[s] + radius_[t]))

@@ -154,6 +154,11 @@ private:
   bool candidatesHold(const NodeArray& x);
   /// The pairs within twice their radii and the skin, through the spatial hash.
   void findCandidates(const NodeArray& x);
+  /// Each segment as a ball at positions y (about its midpoint, of half its length) into middle_ and half_,
+  /// and grid_ built over them for pairs within `reach` [m] of each other.
+  void gridSegments(const NodeArray& y, double reach);
+  /// True if segments s and t end on a common node (neighbours along a rope, a cloth's edges at a corner).
+  bool shareANode(std::size_t s, std::size_t t) const;
 
   /// A face-contact cloth's pairs of edges near each other at rest (their contact within twice their
   /// radii there: neighbours its springs hold apart), into rest_near_.
