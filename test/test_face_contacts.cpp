@@ -375,8 +375,8 @@ TEST_P(ClothOnARail, AClothDroppedOnARailThinnerThanItsSpacingRestsDrapedOnIt)
 // pierced from 0.3 s on); at 4 it holds. Between two rows, at 4 sub-steps, a node at the cloth's edge lying
 // on the rail keeps a velocity of 0.13 m/s along it at 6 s while its position stays still (0.04 m/s at 8
 // sub-steps, 0.012 at 16): the velocity its contacts leave it disagrees with its motion. implicit_euler
-// holds the nodes and the faces on
-// the rail inside its solve (collider_holds.h, surface_holds.h) and rests at one.
+// holds the nodes and the faces on the rail inside its solve (collider_holds.h, surface_holds.h) and rests
+// at one.
 INSTANTIATE_TEST_SUITE_P(Integrators, ClothOnARail,
                          ::testing::Values(RailCase{ "xpbd", 4, 0.0 }, RailCase{ "implicit_euler", 1, 0.0 },
                                            RailCase{ "implicit_euler", 1, 0.025 }),
