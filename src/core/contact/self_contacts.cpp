@@ -211,6 +211,12 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   std::sort(nodes_.begin(), nodes_.end());
   nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
   skin_ = kSkinRadii * largest_radius_;
+  for (std::size_t s = 0; s < segments_.size(); ++s)
+  {
+    const double radii = by_faces_[static_cast<std::size_t>(body_[s])] ? kNearRadiiOfEdges : kNearRadiiOfLinks;
+    near_radius_.push_back(radii * radius_[s]);
+    widest_near_ = std::max(widest_near_, near_radius_.back());
+  }
   if (faces_.empty())
     return;
   findRestNeighbours();
@@ -253,9 +259,9 @@ bool SelfContacts::candidatesHold(const NodeArray& x)
 
 void SelfContacts::findCandidates(const NodeArray& x)
 {
-  // A candidate pair's links come within twice their radii and the skin (see below): their balls within
+  // A candidate pair's links come within their near radii and the skin (see below): their balls within
   // the widest such reach.
-  const double reach = 4.0 * largest_radius_ + skin_;
+  const double reach = 2.0 * widest_near_ + skin_;
   gridSegments(x, reach);
   candidates_.clear();
   // Marks (1) or unmarks (0) segment s's later neighbours at rest, which it never touches; none for
@@ -299,7 +305,7 @@ void SelfContacts::findCandidates(const NodeArray& x)
         return;
       }
     }
-    const double within = 2.0 * (radius_[s] + radius_[t]) + skin_;
+    const double within = near_radius_[s] + near_radius_[t] + skin_;
     // Their balls within their own reach (the grid's is the widest pair's).
     const double bound = half_[s] + half_[t] + within;
     if ((middle_.col(static_cast<Eigen::Index>(s)) - middle_.col(static_cast<Eigen::Index>(t))).squaredNorm() >
@@ -430,7 +436,7 @@ bool SelfContacts::resolve(const Model& model, State& state)
     k.weight = (1.0 - k.p) * k.ka + k.p * k.kb + (1.0 - k.q) * k.kc + k.q * k.kd;
     return k.weight > 0.0;
   };
-  // The pairs that touch, or nearly (within their radii again, as the passes move them).
+  // The pairs that touch, or nearly (within their near radii, as the passes move them).
   near_.clear();
   moved_at_.resize(static_cast<std::size_t>(x.cols()), 0);
   const auto moved = [&](const std::pair<int, int>& segment) {
@@ -439,7 +445,7 @@ bool SelfContacts::resolve(const Model& model, State& state)
   for (const Candidate& candidate : candidates_)
   {
     const std::uint32_t s = candidate.s, t = candidate.t;
-    const double touching = 2.0 * (radius_[s] + radius_[t]);
+    const double touching = near_radius_[s] + near_radius_[t];
     // Their points have moved, relative to the mean motion (which changes no distance), no farther than
     // their farthest node: a pair whose least distance was more than that beyond the contact distance is
     // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
