@@ -234,6 +234,31 @@ TEST(RosConverter, CollidersAreDrawnInTheirCurrentPoseWithTheirExtents)
     ids.insert(m.id);
   }
   EXPECT_EQ(ids.size(), drawn.size());
+  // The state carries each named collider's pose, as drawn: a recording draws them again (state_viewer.h).
+  const SimState state = RosConverter::toState(world, "world", ros::Time(3.0), StepStatistics{});
+  ASSERT_EQ(state.colliders, (std::vector<std::string>{ "ball", "rod", "table", "part" }));
+  ASSERT_EQ(state.collider_poses.size(), 4u);
+  for (const auto& [k, marker] : { std::pair{ 0, 0 }, { 1, 1 }, { 2, 4 }, { 3, 5 } })
+    EXPECT_EQ(state.collider_poses[k], drawn[marker].pose) << state.colliders[k];
+}
+
+TEST(RosConverter, APlaneInTheStateIsAtItsPointWithZAlongItsNormal)
+{
+  SceneDef scene = oneBodyScene(IntegratorType::SemiImplicitEuler, 0.5);
+  scene.colliders.planes.push_back(Plane{ Vec3(0, 0, 1), Vec3(0, -2, 0), 0.0, 0.5, "wall" });
+  Capsule finger;
+  finger.at.name = "finger";
+  finger.at.frame = "gripper";  // not placed until its frame is seen
+  finger.radius = 0.01;
+  scene.colliders.capsules.push_back(finger);
+  const World world = buildWorld(scene);
+  const SimState state = RosConverter::toState(world, "world", ros::Time(1.0), StepStatistics{});
+  ASSERT_EQ(state.colliders, (std::vector<std::string>{ "wall", "finger" }));
+  const std::optional<RigidPose> wall = RosConverter::toRigidPose(state.collider_poses[0]);
+  ASSERT_TRUE(wall);
+  EXPECT_EQ(wall->position, Vec3(0, 0, 1));
+  EXPECT_NEAR((wall->orientation * Vec3::UnitZ() - Vec3(0, -1, 0)).norm(), 0.0, 1e-15);
+  EXPECT_FALSE(RosConverter::toRigidPose(state.collider_poses[1]));  // all zeros: not placed
 }
 
 TEST(RosConverter, ATransformIsARigidPoseUnlessNotFiniteOrWithoutRotation)
@@ -419,6 +444,21 @@ TEST(RosConverter, ARodIsAStripOfItsDiameterWithItsSegmentsFramesTurnedByItsTwis
     EXPECT_NEAR(angle, M_PI / 2 * (j + 0.5) / 10, 1e-9) << "segment " << j;
     EXPECT_EQ(axes->colors[static_cast<std::size_t>(6 * j + 2)].g, 1.0f);
   }
+  // The state carries the twist per node, and the markers drawn from a state rebuilt from the message
+  // are the world's (state_viewer.h).
+  const SimState message = RosConverter::toState(world, "map", ros::Time(1.0), StepStatistics{});
+  ASSERT_EQ(message.bodies[0].twists.size(), 11u);
+  State recorded;
+  recorded.position = world.state().position;
+  recorded.velocity.setZero(3, 11);
+  recorded.twist.setZero(11);
+  for (int i = 0; i < 11; ++i)
+    recorded.twist[i] = message.bodies[0].twists[static_cast<std::size_t>(i)];
+  EXPECT_TRUE(recorded.twist.isApprox(world.state().twist));
+  EXPECT_GT(recorded.twist.cwiseAbs().maxCoeff(), 0.1);
+  EXPECT_EQ(RosConverter::toMarkers(world.model(), recorded, world.controllers(), world.colliderPoses(), "map",
+                                    ros::Time(1.0)),
+            array);
 }
 
 TEST(RosConverter, TheLivePhysicsGoIntoTheReconfigureConfigAndBack)

@@ -55,24 +55,12 @@ std_msgs::ColorRGBA colliderColor()
   return color;
 }
 
-geometry_msgs::Pose pose(const Vec3& position, const Eigen::Quaterniond& orientation)
-{
-  geometry_msgs::Pose out;
-  out.position = RosConverter::toPoint(position);
-  out.orientation.x = orientation.x();
-  out.orientation.y = orientation.y();
-  out.orientation.z = orientation.z();
-  out.orientation.w = orientation.w();
-  return out;
-}
-
 /// Namespace "colliders": per collider k, id 3k its solid (SPHERE, CYLINDER, CUBE, or a MESH_RESOURCE of
 /// the mesh's file at its scale, in its pose); a capsule adds its two end caps as SPHEREs, ids 3k + 1 and
 /// 3k + 2.
-void addColliderMarkers(const World& world, const std::string& frame_id, const ros::Time& stamp,
+void addColliderMarkers(const std::vector<ColliderPose>& poses, const std::string& frame_id, const ros::Time& stamp,
                         visualization_msgs::MarkerArray& array)
 {
-  const std::vector<ColliderPose> poses = world.colliderPoses();
   for (std::size_t k = 0; k < poses.size(); ++k)
   {
     const ColliderPose& c = poses[k];
@@ -90,7 +78,7 @@ void addColliderMarkers(const World& world, const std::string& frame_id, const r
       solid.mesh_resource = c.mesh;
       solid.mesh_use_embedded_materials = false;  // the colliders' grey, as the other shapes
     }
-    solid.pose = pose(c.position, c.orientation);
+    solid.pose = RosConverter::toPose(RigidPose{ c.position, c.orientation });
     solid.scale.x = c.size.x();
     solid.scale.y = c.size.y();
     solid.scale.z = c.size.z();
@@ -102,7 +90,7 @@ void addColliderMarkers(const World& world, const std::string& frame_id, const r
       const Vec3 axis = c.orientation * Vec3(0.0, 0.0, (end == 1 ? 0.5 : -0.5) * c.size.z());
       visualization_msgs::Marker cap = marker(frame_id, stamp, "colliders", id + end,
                                               visualization_msgs::Marker::SPHERE, c.size.x(), colliderColor());
-      cap.pose = pose(c.position + axis, c.orientation);
+      cap.pose = RosConverter::toPose(RigidPose{ c.position + axis, c.orientation });
       array.markers.push_back(cap);
     }
   }
@@ -125,11 +113,10 @@ namespace
 /// "<body>/frames" (which rviz can hide on its own), each segment's material frame as three short lines
 /// from its midpoint, red x along the rod, green y, blue z: a twist shows as the green and blue lines
 /// turning about the rod.
-void addRodMarkers(const World& world, const std::string& frame_id, const ros::Time& stamp,
+void addRodMarkers(const Model& model, const State& state, const std::string& frame_id, const ros::Time& stamp,
                    visualization_msgs::MarkerArray& array)
 {
-  const Model& model = world.model();
-  const NodeArray& x = world.state().position;
+  const NodeArray& x = state.position;
   std::vector<Eigen::Quaterniond> frames;
   for (std::size_t r = 0; r < model.rods.size(); ++r)
   {
@@ -140,7 +127,7 @@ void addRodMarkers(const World& world, const std::string& frame_id, const ros::T
                                               2.0 * model.contact_radius[rod.first], bodyColor(b));
     visualization_msgs::Marker axes =
         marker(frame_id, stamp, name + "/frames", 0, visualization_msgs::Marker::LINE_LIST, 0.5 * kLineWidth, bodyColor(b));
-    rodFrames(rod, x, world.state().twist, frames);
+    rodFrames(rod, x, state.twist, frames);
     const double length = 0.8 * rod.segment_length;
     for (int j = 0; j < rod.count; ++j)
     {
@@ -180,11 +167,9 @@ namespace
 /// Each solid's boundary (BodyRange::surface) as a TRIANGLE_LIST in its body's colour (id 2 in its body's
 /// namespace): rviz shades each triangle by its normal, (b - a) x (c - a), which points out of the solid.
 /// A triangle with a node that is not finite is left out.
-void addVolumeMarkers(const World& world, const std::string& frame_id, const ros::Time& stamp,
+void addVolumeMarkers(const Model& model, const NodeArray& x, const std::string& frame_id, const ros::Time& stamp,
                       visualization_msgs::MarkerArray& array)
 {
-  const Model& model = world.model();
-  const NodeArray& x = world.state().position;
   for (std::size_t b = 0; b < model.bodies.size(); ++b)
   {
     const BodyRange& body = model.bodies[b];
@@ -206,8 +191,15 @@ void addVolumeMarkers(const World& world, const std::string& frame_id, const ros
 visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, const std::string& frame_id,
                                                         const ros::Time& stamp)
 {
-  const Model& model = world.model();
-  const NodeArray& x = world.state().position;
+  return toMarkers(world.model(), world.state(), world.controllers(), world.colliderPoses(), frame_id, stamp);
+}
+
+visualization_msgs::MarkerArray RosConverter::toMarkers(const Model& model, const State& state,
+                                                        const std::vector<BodyController>& controllers,
+                                                        const std::vector<ColliderPose>& colliders,
+                                                        const std::string& frame_id, const ros::Time& stamp)
+{
+  const NodeArray& x = state.position;
   visualization_msgs::MarkerArray array;
   std::vector<int> body_of_node(static_cast<std::size_t>(model.nodeCount()));
   for (std::size_t b = 0; b < model.bodies.size(); ++b)
@@ -246,11 +238,11 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
     if (m.points.empty())
       m.action = visualization_msgs::Marker::DELETE;
 
-  for (const BodyController& controlled : world.controllers())
+  for (const BodyController& controlled : controllers)
   {
     const BodyRange& body = model.bodies[static_cast<std::size_t>(controlled.body)];
     int id = 2;
-    for (const std::vector<Vec3>& curve : controlled.controller->curves(world.state()))
+    for (const std::vector<Vec3>& curve : controlled.controller->curves(state))
     {
       visualization_msgs::Marker strip = marker(frame_id, stamp, body.name, id++, visualization_msgs::Marker::LINE_STRIP,
                                                 2.0 * kLineWidth, bodyColor(static_cast<std::size_t>(controlled.body)));
@@ -260,9 +252,9 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const World& world, cons
       array.markers.push_back(strip);
     }
   }
-  addRodMarkers(world, frame_id, stamp, array);
-  addVolumeMarkers(world, frame_id, stamp, array);
-  addColliderMarkers(world, frame_id, stamp, array);
+  addRodMarkers(model, state, frame_id, stamp, array);
+  addVolumeMarkers(model, x, frame_id, stamp, array);
+  addColliderMarkers(colliders, frame_id, stamp, array);
   return array;
 }
 

@@ -13,6 +13,17 @@ geometry_msgs::Pose RosConverter::toPose(const Vec3& position)
   return pose;
 }
 
+geometry_msgs::Pose RosConverter::toPose(const RigidPose& rigid)
+{
+  geometry_msgs::Pose pose;
+  pose.position = toPoint(rigid.position);
+  pose.orientation.x = rigid.orientation.x();
+  pose.orientation.y = rigid.orientation.y();
+  pose.orientation.z = rigid.orientation.z();
+  pose.orientation.w = rigid.orientation.w();
+  return pose;
+}
+
 bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position, std::string& why)
 {
   const Vec3 p = toVec3(pose.position);
@@ -43,16 +54,30 @@ bool RosConverter::fromPose(const geometry_msgs::Pose& pose, Vec3& position,
   return true;
 }
 
-std::optional<RigidPose> RosConverter::toRigidPose(const geometry_msgs::Transform& transform)
+namespace
 {
-  RigidPose pose;
-  pose.position = toVec3(transform.translation);
-  pose.orientation = Eigen::Quaterniond(transform.rotation.w, transform.rotation.x, transform.rotation.y,
-                                        transform.rotation.z);
+/// A rigid pose at `position` turned by (w, x, y, z) made unit; nullopt if any is not finite or the
+/// rotation is zero.
+std::optional<RigidPose> rigidPose(const Vec3& position, double w, double x, double y, double z)
+{
+  RigidPose pose{ position, Eigen::Quaterniond(w, x, y, z) };
   if (!pose.position.allFinite() || !pose.orientation.coeffs().allFinite() || !(pose.orientation.norm() > 1e-12))
     return std::nullopt;
   pose.orientation.normalize();
   return pose;
+}
+}  // namespace
+
+std::optional<RigidPose> RosConverter::toRigidPose(const geometry_msgs::Transform& transform)
+{
+  const geometry_msgs::Quaternion& q = transform.rotation;
+  return rigidPose(toVec3(transform.translation), q.w, q.x, q.y, q.z);
+}
+
+std::optional<RigidPose> RosConverter::toRigidPose(const geometry_msgs::Pose& pose)
+{
+  const geometry_msgs::Quaternion& q = pose.orientation;
+  return rigidPose(toVec3(pose.position), q.w, q.x, q.y, q.z);
 }
 
 }  // namespace soft_body_sim

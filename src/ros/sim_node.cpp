@@ -48,6 +48,9 @@ void SimNode::initialize()
                           .value_or(workspace_radius_);
   status_period_ =
       readParam<double>(private_nh_, "status_period", "a finite number >= 0 [s]", finiteNonNegative).value_or(0.0);
+  const double state_rate =
+      readParam<double>(private_nh_, "state_rate", "a finite number >= 0 [Hz]", finiteNonNegative).value_or(0.0);
+  state_period_ = state_rate > 0.0 ? 1.0 / state_rate : 0.0;
   force_scale_ = readParam<double>(private_nh_, "force_scale", "a finite number > 0 [m/N]", finitePositive)
                      .value_or(force_scale_);
   const double start_time = readParam<double>(private_nh_, "start_time", "a ROS time in seconds (> 0), or 0",
@@ -110,6 +113,7 @@ void SimNode::addRobotColliders()
 void SimNode::buildWorldFromScene()
 {
   world_ = std::make_unique<World>(buildWorld(scene_));
+  next_state_time_ = world_->time();
   // Live tuning outlives a reset: the sliders keep showing what is in force.
   if (sim_reconfigure_)
     applySimConfig(sim_reconfigure_->config());
@@ -246,8 +250,15 @@ void SimNode::publish()
   const std::vector<Holder> holders = RosConverter::holders(*world_);
   markers_publisher_.publish(RosConverter::toMarkers(*world_, scene_.frame_id, stamp));
   force_markers_publisher_.publish(RosConverter::toForceMarkers(holders, force_scale_, scene_.frame_id, stamp));
-  state_publisher_.publish(RosConverter::toState(*world_, scene_.frame_id, stamp, statistics_, holders, slips_));
-  slips_.clear();
+  // At ~state_rate, on average: at the first tick from each 1 / ~state_rate on, none twice within a tick.
+  if (world_->time() >= next_state_time_)
+  {
+    state_publisher_.publish(RosConverter::toState(*world_, scene_.frame_id, stamp, statistics_, holders, slips_));
+    slips_.clear();
+    next_state_time_ += state_period_;
+    if (next_state_time_ <= world_->time())
+      next_state_time_ = world_->time() + state_period_;
+  }
   publishWrenches(holders, stamp);
   publishColliderWrenches(stamp);
   for (std::size_t k = 0; k < handle_names_.size(); ++k)

@@ -1,8 +1,29 @@
 // RosConverter: the state message, the holders of each body and the wrenches they take.
 #include "soft_body_sim/ros/ros_converter.h"
 
+#include <algorithm>
+
 namespace soft_body_sim
 {
+namespace
+{
+/// The pose of the collider called `name`: a plane's from its point and normal, a shape's from `placed`
+/// (World::colliderPoses), all zeros for a shape not placed yet.
+geometry_msgs::Pose colliderPose(const Colliders& colliders, const std::vector<ColliderPose>& placed,
+                                 const std::string& name)
+{
+  for (const Plane& plane : colliders.planes)
+    if (plane.name == name)
+      return RosConverter::toPose(RigidPose{ plane.point, Eigen::Quaterniond::FromTwoVectors(Vec3::UnitZ(), plane.normal) });
+  for (const ColliderPose& shape : placed)
+    if (shape.name == name)
+      return RosConverter::toPose(RigidPose{ shape.position, shape.orientation });
+  geometry_msgs::Pose none;
+  none.orientation.w = 0.0;
+  return none;
+}
+}  // namespace
+
 std::vector<Holder> RosConverter::holders(const World& world)
 {
   std::vector<Holder> holders;
@@ -45,6 +66,7 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
   state.real_time_factor = statistics.real_time_factor;
   state.wall_seconds_per_step = statistics.wall_seconds_per_step;
   state.divergence_events = statistics.divergence_events;
+  const std::vector<ColliderPose> placed = world.colliderPoses();
   for (const ColliderWrench& collider : world.colliderWrenches())
   {
     state.colliders.push_back(collider.name);
@@ -52,6 +74,7 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
     wrench.force = toVector3(collider.wrench.force);
     wrench.torque = toVector3(collider.wrench.torque);
     state.collider_wrenches.push_back(wrench);
+    state.collider_poses.push_back(colliderPose(model.colliders, placed, collider.name));
   }
   for (std::size_t b = 0; b < world.model().bodies.size(); ++b)
   {
@@ -66,6 +89,9 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
       body.positions.push_back(toPoint(world.state().position.col(i)));
       body.velocities.push_back(toVector3(world.state().velocity.col(i)));
     }
+    if (std::any_of(model.rods.begin(), model.rods.end(), [&](const Rod& rod) { return rod.first == range.first; }))
+      for (int i = range.first; i < range.first + range.count; ++i)
+        body.twists.push_back(world.state().twist[i]);
     for (const Holder& holder : holders)
       if (holder.body == b)
       {

@@ -12,13 +12,20 @@ only the master):
 3. every state published by both at the same simulated instant must be bit-identical in every body:
    same inputs at the same steps, same build, same arithmetic.
 
+Between 1 and 2, the recording as play.launch shows it: the bag holds no markers, is LZ4-compressed and
+at most MAX_BYTES_PER_SECOND of simulated time; the state viewer, fed the bag's states, draws markers
+equal to those the simulator published live at the same instants (to 1e-12 m: a collider's orientation
+is made unit again).
+
 Every step waits for what the next one needs (a topic subscribed, a state past an
 instant) rather than for a fixed time, within STARTUP seconds: on a loaded machine roslaunch alone can
 take several seconds."""
 import glob
+import math
 import os
 import shutil
 import signal
+import struct
 import subprocess
 import tempfile
 import threading
@@ -26,10 +33,12 @@ import time
 
 import rosbag
 import rosgraph
+import roslib.packages
 import rospy
 import rostest
 from geometry_msgs.msg import PoseStamped
 from rosgraph_msgs.msg import Clock
+from visualization_msgs.msg import MarkerArray
 
 from node_client import NodeTestCase, StateWatcher, wait_for
 
@@ -42,6 +51,10 @@ STARTUP = 60.0  # [s] bound on any one wait for a process to come up, subscribe 
 RUN = 8.0  # [s] of the recorded demo from its first input: the gripper's fingers reach the rope by then
 DT = 0.005  # [s] the demo scene's physics.dt
 RATE = 0.5  # of the recording's clock and rosbag play's: ROS seconds per wall second
+MARKERS = NODE + "/markers"
+VIEWED = "/viewer_test/markers"  # the state viewer's markers, apart from the simulator's
+MAX_BYTES_PER_SECOND = 1.5e6  # of the bag, per second of simulated time (issue 34)
+STATE_RATE = 30.0  # [Hz] demo.launch's ~state_rate
 
 
 class HalfSpeedClock:
@@ -84,6 +97,55 @@ def subscriptions(node):
 
 def key(state):
     return state.header.stamp.to_nsec()
+
+
+class RawMarkers:
+    """Keeps every MarkerArray of `topic` as sent, by the stamp of its first marker, to be read later
+    (reading each as it comes would slow the test's process on a busy machine)."""
+
+    def __init__(self, topic):
+        self.by_stamp = {}
+        self.subscriber = rospy.Subscriber(topic, rospy.AnyMsg, self._on_markers, queue_size=1000)
+
+    def _on_markers(self, message):
+        buffer = message._buff
+        # uint32 marker count, then the first marker's header: uint32 seq, uint32 secs, uint32 nsecs
+        if len(buffer) >= 16 and struct.unpack_from("<I", buffer, 0)[0] > 0:
+            secs, nsecs = struct.unpack_from("<II", buffer, 8)
+            self.by_stamp[secs * 10**9 + nsecs] = buffer
+
+    def read(self, stamp):
+        return MarkerArray().deserialize(self.by_stamp[stamp])
+
+    def stop(self):
+        self.subscriber.unregister()
+
+
+def drawn(markers):
+    """Each marker by (namespace, id): its kind and frame, and its numbers in order."""
+    def numbers(m):
+        p, o = m.pose.position, m.pose.orientation
+        values = [p.x, p.y, p.z, o.x, o.y, o.z, o.w, m.scale.x, m.scale.y, m.scale.z,
+                  m.color.r, m.color.g, m.color.b, m.color.a]
+        for point in m.points:
+            values += [point.x, point.y, point.z]
+        for color in m.colors:
+            values += [color.r, color.g, color.b, color.a]
+        return values
+    return {(m.ns, m.id): ((m.type, m.action, m.header.frame_id, m.mesh_resource, len(m.points)), numbers(m))
+            for m in markers.markers}
+
+
+def differences(live, viewed):
+    """Where two marker arrays differ: markers on one side only, another kind, or a number off by 1e-12."""
+    a, b = drawn(live), drawn(viewed)
+    found = [f"{key} only live" for key in a.keys() - b.keys()] + [f"{key} only viewed" for key in b.keys() - a.keys()]
+    for key in a.keys() & b.keys():
+        if a[key][0] != b[key][0]:
+            found.append(f"{key}: {a[key][0]} live, {b[key][0]} viewed")
+        elif not all(math.isclose(x, y, rel_tol=0.0, abs_tol=1e-12) for x, y in zip(a[key][1], b[key][1])):
+            found.append(f"{key}: numbers differ")
+    return found
 
 
 def values(state):
@@ -141,6 +203,7 @@ class ReplayTest(NodeTestCase):
 
     def record_and_replay(self):
         watcher = StateWatcher()
+        live_markers = RawMarkers(MARKERS)
         first_input = []
         rospy.Subscriber(INPUTS[0], PoseStamped, lambda pose: first_input or first_input.append(pose.header.stamp))
 
@@ -153,6 +216,7 @@ class ReplayTest(NodeTestCase):
                   f"state {RUN} s past the first input")
         self.finish("demo")
         clock.stop()
+        live_markers.stop()
         bags = glob.glob(os.path.join(self.folder, "run_*.bag"))
         self.assertEqual(len(bags), 1, os.listdir(self.folder))
         # The start time to replay from, as the README has the user find it (the last one: it may move while
@@ -175,14 +239,17 @@ class ReplayTest(NodeTestCase):
                     inputs += 1
                     late += sum(stamp <= received for stamp in stamps)
                     last_input_time = received
-        self.assertTrue(set(INPUTS) | {"/tf", NODE + "/markers", STATE, START_TIME} <= topics, topics)
+        self.assertTrue(set(INPUTS) | {"/tf", STATE, START_TIME} <= topics, topics)
         # The bag holds every input from the first one the simulator heard (the test may have heard later).
         self.assertLessEqual(first_recorded[INPUTS[0]], first_input[0])
         self.assertGreater(inputs, 3 * 20 * RUN * 0.9)  # three streams at 20 Hz
         # An input played back after its stamp would reach the replaying node late, at another step.
         self.assertEqual(late, 0, f"{late} inputs reached the recorder after their stamp")
 
+        self.check_recording(bags[0], live_markers)
+
         # --- 2. replay the inputs into a fresh node under simulated time
+        rospy.set_param("/use_sim_time", True)
         watcher.states.clear()
         # It publishes after every step (~rate = 1 / dt), so that each recorded state has its replayed twin.
         rospy.set_param(NODE + "/rate", 1.0 / DT)
@@ -203,7 +270,7 @@ class ReplayTest(NodeTestCase):
         replayed = {key(state): values(state) for state in watcher.states}
         span = [stamp for stamp in recorded if stamp <= max(replayed)]  # the replay ends at the bag's last input
         common = sorted(set(span) & set(replayed))
-        self.assertGreater(len(span), 0.5 * 60 * RUN)  # ~rate 60 Hz
+        self.assertGreater(len(span), 0.5 * STATE_RATE * RUN)
         mismatches = [stamp for stamp in common if recorded[stamp] != replayed[stamp]]
         print(f"replay: {len(common)} common instants of {len(recorded)} recorded, {len(replayed)} replayed states; "
               f"{len(mismatches)} differ", flush=True)
@@ -214,6 +281,47 @@ class ReplayTest(NodeTestCase):
             bodies = [name for name in recorded[first] if recorded[first][name] != replayed[first].get(name)]
             self.fail(f"{len(mismatches)} of {len(common)} states differ, the first at "
                       f"{first * 1e-9 - start_time.to_sec():.3f} s in {', '.join(bodies)}")
+
+    def check_recording(self, bag_path, live_markers):
+        """The bag's size and content, and its states drawn by the state viewer as they were live."""
+        with rosbag.Bag(bag_path) as bag:
+            info = bag.get_type_and_topic_info()
+            span = bag.get_end_time() - bag.get_start_time()  # [s] of the recording's (simulated) clock
+            states = [message for _, message, _ in bag.read_messages(topics=[STATE])]
+        size = os.path.getsize(bag_path)
+        print(f"recording: {size / 1e6:.2f} MB over {span:.2f} s of simulated time, {size / span / 1e6:.2f} MB/s; "
+              f"{len(states)} states; topics {sorted(info.topics)}", flush=True)
+        self.assertNotIn(MARKERS, info.topics)
+        compression = subprocess.run(["rosbag", "info", "--yaml", "--key=compression", bag_path],
+                                     capture_output=True, text=True)
+        self.assertEqual(compression.stdout.strip(), "lz4", compression.stderr)
+        self.assertLessEqual(size / span, MAX_BYTES_PER_SECOND)
+
+        # The recorded states, played into the state viewer (no clock: it only draws).
+        rospy.set_param("/use_sim_time", False)
+        viewed = RawMarkers(VIEWED)
+        # By its path: rosrun skips everything under <package>/build, where scripts/test builds.
+        viewer = roslib.packages.find_node("soft_body_sim", "state_viewer")
+        self.assertTrue(viewer, "no state_viewer built")
+        self.launch("viewer", viewer[0],
+                    f"_scene:={os.path.join(os.path.dirname(BAG_START_TIME), '..', 'config', 'scenes', 'demo.yaml')}",
+                    f"state:={STATE}", f"markers:={VIEWED}")
+        self.wait(lambda: STATE in subscriptions("/soft_body_sim_viewer"), "the state viewer's subscription")
+        player = self.launch("viewer_player", "rosbag", "play", "-q", "-r", "2", "--wait-for-subscribers", bag_path,
+                             "--topics", STATE)
+        self.assertEqual(player.wait(timeout=STARTUP + RUN), 0)
+        self.processes.pop("viewer_player")
+        last = max(key(state) for state in states)
+        self.wait(lambda: last in viewed.by_stamp, "the state viewer's markers of the last state")
+        self.finish("viewer")
+        viewed.stop()
+        common = sorted(set(viewed.by_stamp) & set(live_markers.by_stamp))
+        print(f"viewer: {len(viewed.by_stamp)} marker arrays drawn from {len(states)} states, {len(common)} at "
+              f"instants with live markers", flush=True)
+        self.assertGreater(len(common), 0.5 * len(states))
+        for stamp in common[::max(1, len(common) // 40)]:  # 40 of them, across the run
+            found = differences(live_markers.read(stamp), viewed.read(stamp))
+            self.assertFalse(found, f"at {stamp * 1e-9:.3f} s: {found[:5]}")
 
 
 if __name__ == "__main__":

@@ -54,6 +54,12 @@ public:
   /// without points (a body without springs) is sent with action DELETE.
   static visualization_msgs::MarkerArray toMarkers(const World& world, const std::string& frame_id,
                                                    const ros::Time& stamp);
+  /// The same of a model in `state`, its bodies' `controllers` and the colliders in `colliders`' poses
+  /// (World::colliderPoses): what a world shows, drawn from a recorded state (state_viewer.h).
+  static visualization_msgs::MarkerArray toMarkers(const Model& model, const State& state,
+                                                   const std::vector<BodyController>& controllers,
+                                                   const std::vector<ColliderPose>& colliders,
+                                                   const std::string& frame_id, const ros::Time& stamp);
   /// The forces on the holders (see holders()): a DELETEALL (arrows of holders gone disappear), then in
   /// namespace "forces" per holder k, id k, an ARROW from its origin along the force the body exerts on
   /// it, force_scale [m/N] long.
@@ -83,6 +89,8 @@ public:
 
   /// A pose at `position` [m] with the identity orientation (anchors and handles have no orientation).
   static geometry_msgs::Pose toPose(const Vec3& position);
+  /// A rigid pose as a message pose, as it is.
+  static geometry_msgs::Pose toPose(const RigidPose& pose);
   /// The point of a message [m], as it is (not checked: see fromPose for inputs).
   static Vec3 toVec3(const geometry_msgs::Point& point) { return Vec3(point.x, point.y, point.z); }
   /// A translation [m], as it is.
@@ -94,6 +102,8 @@ public:
 
   /// A transform as a rigid pose; nullopt if any field is not finite or the rotation is zero.
   static std::optional<RigidPose> toRigidPose(const geometry_msgs::Transform& transform);
+  /// A pose as a rigid pose; nullopt if any field is not finite or the orientation is zero.
+  static std::optional<RigidPose> toRigidPose(const geometry_msgs::Pose& pose);
 
   // --- dynamic_reconfigure configs (reconfigure_conversion.cpp) ---
 

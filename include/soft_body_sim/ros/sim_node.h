@@ -140,6 +140,8 @@ private:
   std::unique_ptr<World> world_;
   double rate_ = 60.0;          ///< [Hz] of the timer
   double status_period_ = 0.0;  ///< [s] between status lines on the console; 0 = none
+  double state_period_ = 0.0;   ///< 1 / ~state_rate [s] between ~state messages; 0 = every tick
+  double next_state_time_ = 0.0;  ///< [s] of simulated time: ~state goes out at the first tick from it on
   long max_steps_per_tick_ = 1;  ///< catch-up cap: two ticks' worth of steps
   double tick_budget_ = 0.0;     ///< ~tick_budget [s]: wall time after which a tick begins no further step
   double workspace_radius_ = 1.0e4;  ///< ~workspace_radius [m]: inputs further from the scene origin are dropped
