@@ -96,6 +96,7 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
       if (holder.body == b)
       {
         body.holders.push_back(holder.name);
+        body.holder_points.push_back(toPoint(holder.origin));
         geometry_msgs::Wrench wrench;
         wrench.force = toVector3(holder.wrench.force);
         wrench.torque = toVector3(holder.wrench.torque);

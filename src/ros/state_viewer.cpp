@@ -21,6 +21,8 @@ void StateViewer::initialize()
   scene_path_ = *scene;
   scene_ = loadSceneFile(scene_path_);
   world_ = std::make_unique<World>(buildWorld(scene_));
+  force_scale_ = readParam<double>(private_nh_, "force_scale", "a finite number > 0 [m/N]", finitePositive)
+                     .value_or(force_scale_);
   Colliders shapes = scene_.colliders;
   if (scene_.robot_colliders)
   {
@@ -47,13 +49,15 @@ void StateViewer::initialize()
   for (const Mesh& m : shapes.meshes)
     colliders_.push_back(ColliderPose::of(m));
   publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("markers", 1);
+  force_publisher_ = nh_.advertise<visualization_msgs::MarkerArray>("force_markers", 1);
   subscriber_ = nh_.subscribe("state", 10, &StateViewer::onState, this);
   ROS_INFO("state viewer: scene %s, %d nodes in %zu bodies; drawing %s onto %s", scene_path_.c_str(),
            world_->model().nodeCount(), world_->model().bodies.size(), subscriber_.getTopic().c_str(),
            publisher_.getTopic().c_str());
 }
 
-bool StateViewer::draw(const SimState& message, visualization_msgs::MarkerArray& markers, std::string& why) const
+bool StateViewer::draw(const SimState& message, visualization_msgs::MarkerArray& markers,
+                       visualization_msgs::MarkerArray& force_markers, std::string& why) const
 {
   const Model& model = world_->model();
   if (message.bodies.size() != model.bodies.size())
@@ -107,20 +111,31 @@ bool StateViewer::draw(const SimState& message, visualization_msgs::MarkerArray&
   }
   markers = RosConverter::toMarkers(model, state, world_->controllers(), colliders, message.header.frame_id,
                                     message.header.stamp);
+  // The holders body by body (the simulator numbers its arrows anchors first, then grasps: the same arrows).
+  std::vector<Holder> holders;
+  for (std::size_t b = 0; b < message.bodies.size(); ++b)
+  {
+    const BodyState& body = message.bodies[b];
+    for (std::size_t k = 0; k < body.holders.size() && k < body.holder_points.size() && k < body.wrenches.size(); ++k)
+      holders.push_back({ b, body.holders[k], RosConverter::toVec3(body.holder_points[k]),
+                          Wrench{ RosConverter::toVec3(body.wrenches[k].force), RosConverter::toVec3(body.wrenches[k].torque) } });
+  }
+  force_markers = RosConverter::toForceMarkers(holders, force_scale_, message.header.frame_id, message.header.stamp);
   return true;
 }
 
 void StateViewer::onState(const SimState& message)
 {
-  visualization_msgs::MarkerArray markers;
+  visualization_msgs::MarkerArray markers, force_markers;
   std::string why;
-  if (!draw(message, markers, why))
+  if (!draw(message, markers, force_markers, why))
   {
     ROS_ERROR_THROTTLE(5.0, "state viewer: %s at %.3f: %s (is %s the recording's scene?); not drawn",
                        subscriber_.getTopic().c_str(), message.header.stamp.toSec(), why.c_str(), scene_path_.c_str());
     return;
   }
   publisher_.publish(markers);
+  force_publisher_.publish(force_markers);
 }
 
 }  // namespace soft_body_sim

@@ -52,7 +52,9 @@ RUN = 8.0  # [s] of the recorded demo from its first input: the gripper's finger
 DT = 0.005  # [s] the demo scene's physics.dt
 RATE = 0.5  # of the recording's clock and rosbag play's: ROS seconds per wall second
 MARKERS = NODE + "/markers"
+FORCE_MARKERS = NODE + "/force_markers"
 VIEWED = "/viewer_test/markers"  # the state viewer's markers, apart from the simulator's
+VIEWED_FORCES = "/viewer_test/force_markers"
 MAX_BYTES_PER_SECOND = 1.5e6  # of the bag, per second of simulated time (issue 34)
 STATE_RATE = 30.0  # [Hz] demo.launch's ~state_rate
 
@@ -121,19 +123,28 @@ class RawMarkers:
         self.subscriber.unregister()
 
 
+def numbers(marker):
+    """A marker's numbers in order: pose, scale, colour, then its points and their colours."""
+    p, o = marker.pose.position, marker.pose.orientation
+    values = [p.x, p.y, p.z, o.x, o.y, o.z, o.w, marker.scale.x, marker.scale.y, marker.scale.z,
+              marker.color.r, marker.color.g, marker.color.b, marker.color.a]
+    for point in marker.points:
+        values += [point.x, point.y, point.z]
+    for color in marker.colors:
+        values += [color.r, color.g, color.b, color.a]
+    return values
+
+
 def drawn(markers):
-    """Each marker by (namespace, id): its kind and frame, and its numbers in order."""
-    def numbers(m):
-        p, o = m.pose.position, m.pose.orientation
-        values = [p.x, p.y, p.z, o.x, o.y, o.z, o.w, m.scale.x, m.scale.y, m.scale.z,
-                  m.color.r, m.color.g, m.color.b, m.color.a]
-        for point in m.points:
-            values += [point.x, point.y, point.z]
-        for color in m.colors:
-            values += [color.r, color.g, color.b, color.a]
-        return values
+    """Each marker by (namespace, id): its kind and frame, and its numbers."""
     return {(m.ns, m.id): ((m.type, m.action, m.header.frame_id, m.mesh_resource, len(m.points)), numbers(m))
             for m in markers.markers}
+
+
+def arrows(markers):
+    """The force arrows, each as its numbers, sorted: the simulator numbers them anchors first, then
+    grasps, the viewer body by body."""
+    return sorted(numbers(m) for m in markers.markers if m.type == m.ARROW and m.action == m.ADD)
 
 
 def differences(live, viewed):
@@ -204,6 +215,7 @@ class ReplayTest(NodeTestCase):
     def record_and_replay(self):
         watcher = StateWatcher()
         live_markers = RawMarkers(MARKERS)
+        live_forces = RawMarkers(FORCE_MARKERS)
         first_input = []
         rospy.Subscriber(INPUTS[0], PoseStamped, lambda pose: first_input or first_input.append(pose.header.stamp))
 
@@ -217,6 +229,7 @@ class ReplayTest(NodeTestCase):
         self.finish("demo")
         clock.stop()
         live_markers.stop()
+        live_forces.stop()
         bags = glob.glob(os.path.join(self.folder, "run_*.bag"))
         self.assertEqual(len(bags), 1, os.listdir(self.folder))
         # The start time to replay from, as the README has the user find it (the last one: it may move while
@@ -246,7 +259,7 @@ class ReplayTest(NodeTestCase):
         # An input played back after its stamp would reach the replaying node late, at another step.
         self.assertEqual(late, 0, f"{late} inputs reached the recorder after their stamp")
 
-        self.check_recording(bags[0], live_markers)
+        self.check_recording(bags[0], live_markers, live_forces)
 
         # --- 2. replay the inputs into a fresh node under simulated time
         rospy.set_param("/use_sim_time", True)
@@ -282,7 +295,7 @@ class ReplayTest(NodeTestCase):
             self.fail(f"{len(mismatches)} of {len(common)} states differ, the first at "
                       f"{first * 1e-9 - start_time.to_sec():.3f} s in {', '.join(bodies)}")
 
-    def check_recording(self, bag_path, live_markers):
+    def check_recording(self, bag_path, live_markers, live_forces):
         """The bag's size and content, and its states drawn by the state viewer as they were live."""
         with rosbag.Bag(bag_path) as bag:
             info = bag.get_type_and_topic_info()
@@ -299,13 +312,13 @@ class ReplayTest(NodeTestCase):
 
         # The recorded states, played into the state viewer (no clock: it only draws).
         rospy.set_param("/use_sim_time", False)
-        viewed = RawMarkers(VIEWED)
+        viewed, viewed_forces = RawMarkers(VIEWED), RawMarkers(VIEWED_FORCES)
         # By its path: rosrun skips everything under <package>/build, where scripts/test builds.
         viewer = roslib.packages.find_node("soft_body_sim", "state_viewer")
         self.assertTrue(viewer, "no state_viewer built")
         self.launch("viewer", viewer[0],
                     f"_scene:={os.path.join(os.path.dirname(BAG_START_TIME), '..', 'config', 'scenes', 'demo.yaml')}",
-                    f"state:={STATE}", f"markers:={VIEWED}")
+                    f"state:={STATE}", f"markers:={VIEWED}", f"force_markers:={VIEWED_FORCES}")
         self.wait(lambda: STATE in subscriptions("/soft_body_sim_viewer"), "the state viewer's subscription")
         player = self.launch("viewer_player", "rosbag", "play", "-q", "-r", "2", "--wait-for-subscribers", bag_path,
                              "--topics", STATE)
@@ -315,6 +328,7 @@ class ReplayTest(NodeTestCase):
         self.wait(lambda: last in viewed.by_stamp, "the state viewer's markers of the last state")
         self.finish("viewer")
         viewed.stop()
+        viewed_forces.stop()
         common = sorted(set(viewed.by_stamp) & set(live_markers.by_stamp))
         print(f"viewer: {len(viewed.by_stamp)} marker arrays drawn from {len(states)} states, {len(common)} at "
               f"instants with live markers", flush=True)
@@ -322,6 +336,15 @@ class ReplayTest(NodeTestCase):
         for stamp in common[::max(1, len(common) // 40)]:  # 40 of them, across the run
             found = differences(live_markers.read(stamp), viewed.read(stamp))
             self.assertFalse(found, f"at {stamp * 1e-9:.3f} s: {found[:5]}")
+        common = sorted(set(viewed_forces.by_stamp) & set(live_forces.by_stamp))
+        self.assertGreater(len(common), 0.5 * len(states))
+        for stamp in common[::max(1, len(common) // 40)]:
+            live, viewed_arrows = arrows(live_forces.read(stamp)), arrows(viewed_forces.read(stamp))
+            self.assertGreater(len(live), 0)  # the demo's anchors
+            self.assertEqual(len(live), len(viewed_arrows), f"at {stamp * 1e-9:.3f} s")
+            for a, b in zip(live, viewed_arrows):
+                self.assertTrue(all(math.isclose(x, y, rel_tol=0.0, abs_tol=1e-12) for x, y in zip(a, b)),
+                                f"at {stamp * 1e-9:.3f} s: a force arrow differs")
 
 
 if __name__ == "__main__":

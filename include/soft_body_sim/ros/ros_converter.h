@@ -63,6 +63,8 @@ public:
   /// The forces on the holders (see holders()): a DELETEALL (arrows of holders gone disappear), then in
   /// namespace "forces" per holder k, id k, an ARROW from its origin along the force the body exerts on
   /// it, force_scale [m/N] long.
+  /// [m/N] the force arrows' length per newton unless ~force_scale says otherwise.
+  static constexpr double kForceScale = 0.02;
   static visualization_msgs::MarkerArray toForceMarkers(const std::vector<Holder>& holders, double force_scale,
                                                         const std::string& frame_id, const ros::Time& stamp);
 

@@ -196,7 +196,7 @@ private:
   };
   std::vector<HeldNode> held_;  ///< as the current tick began
   std::set<std::string> slash_warned_;  ///< sources warned about a frame name's leading slash (tfFrame)
-  double force_scale_ = 0.02;     ///< ~force_scale [m/N]: length of the force arrows on ~force_markers
+  double force_scale_ = RosConverter::kForceScale;     ///< ~force_scale [m/N]: length of the force arrows on ~force_markers
 };
 
 }  // namespace soft_body_sim

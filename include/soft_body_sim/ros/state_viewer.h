@@ -13,11 +13,13 @@
 #include "soft_body_sim/SimState.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/core/world.h"
+#include "soft_body_sim/ros/ros_converter.h"
 
 namespace soft_body_sim
 {
-/// Subscribes to `state` (soft_body_sim/SimState) and publishes `markers` (visualization_msgs/MarkerArray),
-/// both relative to `nh`, from the scene file in `~scene` of `private_nh`.
+/// Subscribes to `state` (soft_body_sim/SimState) and publishes `markers` and `force_markers`
+/// (visualization_msgs/MarkerArray), all relative to `nh`, from the scene file in `~scene` of `private_nh`
+/// (and the arrows' `~force_scale` [m/N], as the simulator's).
 class StateViewer
 {
 public:
@@ -27,9 +29,10 @@ public:
   /// subscribes and advertises. Throws std::runtime_error, naming the parameter or file, if it cannot.
   void initialize();
 
-  /// The markers of `message` drawn on the scene's bodies; false (and why) if its bodies are not the
-  /// scene's (names and node counts, in order) or a position is not finite.
-  bool draw(const SimState& message, visualization_msgs::MarkerArray& markers, std::string& why) const;
+  /// The markers of `message` drawn on the scene's bodies, and the forces on their holders; false (and
+  /// why) if its bodies are not the scene's (names and node counts, in order) or a position is not finite.
+  bool draw(const SimState& message, visualization_msgs::MarkerArray& markers,
+            visualization_msgs::MarkerArray& force_markers, std::string& why) const;
 
 private:
   void onState(const SimState& message);
@@ -42,6 +45,8 @@ private:
   std::vector<ColliderPose> colliders_;  ///< every shape of the scene, in the simulator's drawing order
   ros::Subscriber subscriber_;
   ros::Publisher publisher_;
+  ros::Publisher force_publisher_;
+  double force_scale_ = RosConverter::kForceScale;
 };
 
 }  // namespace soft_body_sim
