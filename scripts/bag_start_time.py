@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Prints the ~start_time to replay a bag recorded with record.launch: the ROS time of simulated time 0,
-in seconds to the millisecond, as sim.launch's start_time:= takes it (README, "Record and replay").
+in seconds to the millisecond, as sim.launch's start_time:= takes it (docs/node.md, "Record and replay").
 
   rosrun soft_body_sim bag_start_time.py /tmp/run_2026-11-26-19-00-00.bag [--node /soft_body_sim]
 

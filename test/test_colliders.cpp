@@ -393,7 +393,7 @@ TEST(ColliderContact, AFingerSweptThroughAHangingRopePushesItAndNeverPassesThrou
 // swings on around it, its tip winding more than a half turn about the rod's axis in 0.15 s (turning
 // freely about the pinned end instead, it would wind 2.4 rad), while no link ever enters the rod
 // (brute-force distance from the rod's axis, every step). The sub-step (1/1920 s) moves the tip 5.2 mm, less than the rod's and
-// rope's radii together (7 mm), the README's rule against passing through.
+// rope's radii together (7 mm), the rule against passing through of docs/scenes.md, "Colliders".
 TEST(ColliderContact, ARopeWhirledAt10MetresPerSecondWrapsAroundAThinRod)
 {
   SceneDef scene;

@@ -669,7 +669,7 @@ TEST_P(SolidOnThinRods, ABoxOnTwoRodsThinnerThanItsTetrahedraRestsOnThemAndTheyC
 }
 
 // At one sub-step of 1/60 s the box gains g h^2 = 2.7 mm of fall in a step, more than the rods' radius, which
-// README "Colliders" asks a scene not to exceed (measured: it ends 2 mm into them).
+// docs/scenes.md, "Colliders", asks a scene not to exceed (measured: it ends 2 mm into them).
 INSTANTIATE_TEST_SUITE_P(Substeps, SolidOnThinRods, ::testing::Values(2, 4));
 
 class ThinRodIntoSolid : public ::testing::TestWithParam<int>

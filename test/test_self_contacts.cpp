@@ -261,7 +261,7 @@ TEST(SelfContacts, ACoiledRopeDroppedOnTheFloorNeverPassesThroughItself)
   }
 }
 
-// A rod's segments keep apart by its radius as a rope's do (README "Rods"). The cable of cable.yaml, its
+// A rod's segments keep apart by its radius as a rope's do (docs/scenes.md, "Rods"). The cable of cable.yaml, its
 // tip moved half its length in and turned four turns in 2 s: the twist coils the sagging slack into a
 // plectoneme, whose turns press on each other. With self-collision every two segments (not neighbours)
 // stay at least the diameter apart, less 10 % (as the coil above; measured 0.94 of it); without, the coil

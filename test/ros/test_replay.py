@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Determinism through rosbag, on the demo as the README tells it (launched by replay.test, which starts
+"""Determinism through rosbag, on the demo as docs/node.md tells it (launched by replay.test, which starts
 only the master):
 
 1. record: demo.launch rviz:=false record:=<folder>/run: send_targets.py streams the rope's right end,
@@ -232,7 +232,7 @@ class ReplayTest(NodeTestCase):
         live_forces.stop()
         bags = glob.glob(os.path.join(self.folder, "run_*.bag"))
         self.assertEqual(len(bags), 1, os.listdir(self.folder))
-        # The start time to replay from, as the README has the user find it (the last one: it may move while
+        # The start time to replay from, as docs/node.md has the user find it (the last one: it may move while
         # the demo starts up, not after the first input).
         found = subprocess.run([BAG_START_TIME, bags[0]], capture_output=True, text=True)
         self.assertEqual(found.returncode, 0, found.stderr)

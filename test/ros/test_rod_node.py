@@ -93,7 +93,7 @@ class RodNodeTest(NodeTestCase):
         self.settle()
         self.assertAlmostEqual(self.latest_torque().x, 0.0, delta=1e-9)
         # Position only (orientation all zeros): the tip moves 5 cm in, 5 mm at a time (less than a
-        # segment per step: README "Rods"), untwisted.
+        # segment per step: docs/scenes.md, "Rods"), untwisted.
         moved = (0.45, 0.0, 1.0)
         for k in range(1, 11):
             self.tip.publish(tip_pose((0.5 - 0.005 * k, 0.0, 1.0), (0.0, 0.0, 0.0, 0.0)))

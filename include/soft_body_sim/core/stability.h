@@ -43,8 +43,8 @@ RateBounds rateBounds(const Model& model, const State& state);
 ///    e^-z (rk4, diverges above 2.79). Past 1 none of them resolves the damping in time.
 ///  - stiffness: omega_max h >= the scheme's limit for an undamped oscillator: 2 (symplectic Euler,
 ///    both Verlets), 2 sqrt(2) (rk4). Explicit Euler has no such limit: it amplifies every undamped
-///    mode by 1 + (omega h)^2 in energy per step at any h (README); it is reported at 2 as well, where
-///    that factor reaches 5.
+///    mode by 1 + (omega h)^2 in energy per step at any h (docs/physics.md, "Integrators"); it is
+///    reported at 2 as well, where that factor reaches 5.
 ///  - explicit Euler only: any spring whose mode is under-damped for the step, h omega^2 >= beta
 ///    (omega^2 = k (1/m_a + 1/m_b), beta = c (1/m_a + 1/m_b) + drag): such a mode grows at any h.
 std::vector<std::string> stabilityWarnings(const Model& model, const State& state, IntegratorType type,
