@@ -33,7 +33,6 @@ import time
 
 import rosbag
 import rosgraph
-import roslib.packages
 import rospy
 import rostest
 from geometry_msgs.msg import PoseStamped
@@ -313,10 +312,7 @@ class ReplayTest(NodeTestCase):
         # The recorded states, played into the state viewer (no clock: it only draws).
         rospy.set_param("/use_sim_time", False)
         viewed, viewed_forces = RawMarkers(VIEWED), RawMarkers(VIEWED_FORCES)
-        # By its path: rosrun skips everything under <package>/build, where scripts/test builds.
-        viewer = roslib.packages.find_node("soft_body_sim", "state_viewer")
-        self.assertTrue(viewer, "no state_viewer built")
-        self.launch("viewer", viewer[0],
+        self.launch("viewer", "rosrun", "soft_body_sim", "state_viewer",
                     f"_scene:={os.path.join(os.path.dirname(BAG_START_TIME), '..', 'config', 'scenes', 'demo.yaml')}",
                     f"state:={STATE}", f"markers:={VIEWED}", f"force_markers:={VIEWED_FORCES}")
         self.wait(lambda: STATE in subscriptions("/soft_body_sim_viewer"), "the state viewer's subscription")
