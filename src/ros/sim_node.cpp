@@ -129,6 +129,7 @@ void SimNode::buildWorldFromScene()
       followFrame(*at);
   targets_.clear();
   inputs_.clear();
+  glides_.clear();
 }
 
 void SimNode::onTimer(const ros::TimerEvent&)

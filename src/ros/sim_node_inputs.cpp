@@ -60,6 +60,9 @@ InputLimits SimNode::readInputLimits() const
 void SimNode::subscribeInputs()
 {
   inputs_.setLimits(readInputLimits());
+  max_input_interval_ = readParam<double>(private_nh_, "max_input_interval", "a finite number of seconds >= 0",
+                                          finiteNonNegative)
+                            .value_or(max_input_interval_);
   for (std::size_t k = 0; k < world_->model().anchors.size(); ++k)
   {
     const Anchor& anchor = world_->model().anchors[k];
@@ -148,15 +151,27 @@ void SimNode::schedule(const std::string& topic, const ros::Time& stamp, const S
 
 void SimNode::applyDueInputs(const ros::Time& step_end)
 {
+  const double start = world_->time(), end = (step_end - epoch_).toSec();
+  std::vector<int> given;  // anchors with an input this step
+  const auto move = [&](int anchor, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation) {
+    if (orientation)
+      world_->moveAnchor(anchor, position, *orientation);
+    else
+      world_->moveAnchor(anchor, position);
+  };
   for (const ScheduledInput& input : inputs_.due(step_end))
   {
     if (input.kind == ScheduledInput::Kind::Anchor)
     {
       warnIfRodEndJumps(input);
-      if (input.orientation)
-        world_->moveAnchor(input.anchor, input.position, *input.orientation);
+      if (max_input_interval_ > 0.0)
+      {
+        glides_[input.anchor].add((input.stamp - epoch_).toSec(), input.position, input.orientation,
+                                  max_input_interval_);
+        given.push_back(input.anchor);
+      }
       else
-        world_->moveAnchor(input.anchor, input.position);
+        move(input.anchor, input.position, input.orientation);
       continue;
     }
     world_->setTarget(input.body, input.position);
@@ -170,6 +185,10 @@ void SimNode::applyDueInputs(const ros::Time& step_end)
     if (!known)
       targets_.emplace_back(input.body, input.position);
   }
+  // Every anchor whose commanded pose changes in this step goes where its glide is at the step's end.
+  for (const auto& [anchor, glide] : glides_)
+    if (glide.movingAfter(start) || std::find(given.begin(), given.end(), anchor) != given.end())
+      move(anchor, glide.positionAt(end), glide.orientationAt(end));
 }
 
 void SimNode::warnIfRodEndJumps(const ScheduledInput& input) const

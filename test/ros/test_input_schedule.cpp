@@ -3,9 +3,11 @@
 // are refused at the limits' exact bounds; each source holds at most max_held inputs, the latest ones.
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "soft_body_sim/ros/input_glide.h"
 #include "soft_body_sim/ros/input_schedule.h"
 
 namespace soft_body_sim
@@ -84,7 +86,10 @@ TEST(InputSchedule, AStampZeroMeansNow)
   EXPECT_EQ(admission.verdict, Verdict::Held);
   EXPECT_EQ(admission.offset, 0.0);
   EXPECT_TRUE(schedule.due(kNow).empty());  // a step ending at now: stamped now falls in the one after
-  EXPECT_EQ(xs(schedule.due(kNow + kNanosecond)), std::vector<double>{ 1.0 });
+  const std::vector<ScheduledInput> due = schedule.due(kNow + kNanosecond);
+  ASSERT_EQ(due.size(), 1u);
+  EXPECT_EQ(due[0].position.x(), 1.0);
+  EXPECT_EQ(due[0].stamp, kNow);  // the instant it was dated to, for its glide (input_glide.h)
 }
 
 TEST(InputSchedule, AStaleStampIsDroppedBeyondMaxAgeAndGoesToTheNextStepWithinIt)
@@ -186,6 +191,106 @@ TEST(InputSchedule, LimitsChangeForLaterPushesAndClearEmptiesEverySource)
   schedule.clear();
   EXPECT_EQ(schedule.size(), 0u);
   EXPECT_TRUE(schedule.due(kNow + ros::Duration(10.0)).empty());
+}
+
+// --- the glide between an anchor's inputs (input_glide.h) ---
+
+TEST(InputGlide, TheFirstInputIsReachedAtOnceAndLaterOnesOverTheIntervalSinceThePrevious)
+{
+  InputGlide glide;
+  glide.add(1.0, Vec3(1, 0, 0), std::nullopt, 0.5);
+  EXPECT_EQ(glide.positionAt(1.0), Vec3(1, 0, 0));
+  EXPECT_FALSE(glide.movingAfter(1.0));
+  // 0.05 s later (20 Hz), 2 cm on: reached 0.05 s after its stamp, linearly, from where the glide was.
+  glide.add(1.05, Vec3(1.02, 0, 0), std::nullopt, 0.5);
+  EXPECT_TRUE(glide.movingAfter(1.05));
+  EXPECT_EQ(glide.positionAt(1.05), Vec3(1, 0, 0));
+  EXPECT_NEAR(glide.positionAt(1.075).x(), 1.01, 1e-15);
+  EXPECT_EQ(glide.positionAt(1.1), Vec3(1.02, 0, 0));  // exactly the input once there
+  EXPECT_EQ(glide.positionAt(7.0), Vec3(1.02, 0, 0));  // inputs stopped: it holds the last
+  EXPECT_FALSE(glide.movingAfter(1.1));
+  // An input with the previous one's stamp: no interval, reached at once.
+  glide.add(1.05, Vec3(2, 0, 0), std::nullopt, 0.5);
+  EXPECT_EQ(glide.positionAt(1.05), Vec3(2, 0, 0));
+}
+
+TEST(InputGlide, AStreamAlongAPathMovesAtThePathsSpeedOneIntervalBehind)
+{
+  // A circle of 0.25 m, one turn in 4 s, sent at 20 Hz: at no instant faster than the path.
+  const double radius = 0.25, omega = 2.0 * M_PI / 4.0, period = 0.05;
+  const auto path = [&](double t) { return Vec3(radius * std::cos(omega * t), 0.0, radius * std::sin(omega * t)); };
+  InputGlide glide;
+  double fastest = 0.0;
+  Vec3 last = path(0.0);
+  glide.add(0.0, last, std::nullopt, 0.5);
+  for (int k = 1; k <= 80; ++k)
+  {
+    glide.add(k * period, path(k * period), std::nullopt, 0.5);
+    for (int j = 1; j <= 10; ++j)  // 5 ms steps
+    {
+      const Vec3 now = glide.positionAt(k * period + j * 0.005);
+      fastest = std::max(fastest, (now - last).norm() / 0.005);
+      last = now;
+    }
+    EXPECT_LT((last - path(k * period)).norm(), 1e-15);  // one interval after each stamp, at its input
+  }
+  EXPECT_LE(fastest, radius * omega * (1.0 + 1e-12));  // a chord is shorter than its arc
+  EXPECT_GT(fastest, 0.99 * radius * omega);
+}
+
+TEST(InputGlide, AJitteryStreamAlongALineMovesNoFasterThanTheStream)
+{
+  // 1 m/s along x, sent at intervals of 38 and 62 ms in turn (a loaded publisher): where each input was
+  // reached one interval after its stamp, a short interval after a long one ran at 62 / 38 = 1.6 m/s.
+  std::vector<double> stamps = { 0.0 };
+  for (int k = 1; k <= 40; ++k)
+    stamps.push_back(stamps.back() + (k % 2 == 0 ? 0.038 : 0.062));
+  InputGlide glide;
+  double fastest = 0.0, clock = 0.0;
+  Vec3 last = Vec3::Zero();
+  for (std::size_t k = 0; k < stamps.size(); ++k)
+  {
+    glide.add(stamps[k], Vec3(stamps[k], 0, 0), std::nullopt, 0.5);
+    const double next = k + 1 < stamps.size() ? stamps[k + 1] : stamps[k] + 0.2;
+    for (; clock + 0.005 <= next; clock += 0.005)  // 5 ms steps up to the next input
+    {
+      const Vec3 now = glide.positionAt(clock + 0.005);
+      fastest = std::max(fastest, (now - last).norm() / 0.005);
+      last = now;
+    }
+  }
+  EXPECT_LE(fastest, 1.0 + 1e-9);
+  EXPECT_GT(fastest, 0.99);
+  EXPECT_EQ(last, Vec3(stamps.back(), 0, 0));
+}
+
+TEST(InputGlide, AfterAPauseLongerThanTheLongestIntervalAnInputIsReachedOverThatInterval)
+{
+  InputGlide glide;
+  glide.add(0.0, Vec3::Zero(), std::nullopt, 0.25);
+  glide.add(10.0, Vec3(1, 0, 0), std::nullopt, 0.25);
+  EXPECT_NEAR(glide.positionAt(10.125).x(), 0.5, 1e-12);
+  EXPECT_EQ(glide.positionAt(10.25), Vec3(1, 0, 0));
+  // Late: stamped 0.1 s before the step that reads it, it is 0.1 s along by then.
+  glide.add(10.4, Vec3(2, 0, 0), std::nullopt, 0.25);
+  EXPECT_NEAR(glide.positionAt(10.5).x(), 1.4, 1e-12);
+}
+
+TEST(InputGlide, AnOrientationTurnsBySlerpWithThePosition)
+{
+  InputGlide glide;
+  const Eigen::Quaterniond start = Eigen::Quaterniond::Identity();
+  const Eigen::Quaterniond turned(Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()));
+  glide.add(0.0, Vec3::Zero(), start, 0.5);
+  glide.add(0.1, Vec3(1, 0, 0), turned, 0.5);
+  const std::optional<Eigen::Quaterniond> half = glide.orientationAt(0.15);
+  ASSERT_TRUE(half);
+  EXPECT_NEAR(half->angularDistance(start), M_PI / 4, 1e-12);
+  EXPECT_NEAR(half->angularDistance(turned), M_PI / 4, 1e-12);
+  EXPECT_TRUE(glide.orientationAt(0.2)->isApprox(turned, 0.0));
+  // Inputs without an orientation leave it to the anchor.
+  glide.add(0.3, Vec3(2, 0, 0), std::nullopt, 0.5);
+  EXPECT_FALSE(glide.orientationAt(0.35));
 }
 
 }  // namespace

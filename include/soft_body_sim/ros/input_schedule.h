@@ -44,6 +44,7 @@ struct ScheduledInput
   /// Kind::Anchor: the orientation in the scene frame (turns an anchor holding a rod's end); none: it keeps
   /// its orientation.
   std::optional<Eigen::Quaterniond> orientation;
+  ros::Time stamp;  ///< when it takes effect (InputSchedule::push: its header's stamp, or now for 0)
 };
 
 /// The bounds of InputSchedule (the node's ~max_input_age, ~max_input_lead, ~max_held_inputs).
@@ -99,7 +100,8 @@ public:
       }
     }
     Held& held = sources_[sourceOf(input)];
-    held.emplace(when, Entry{ next_arrival_++, input });
+    const auto placed = held.emplace(when, Entry{ next_arrival_++, input });
+    placed->second.input.stamp = when;
     if (held.size() > std::max<std::size_t>(1, limits_.max_held))
     {
       held.erase(held.begin());  // the earliest stamp, of equal stamps the first to arrive

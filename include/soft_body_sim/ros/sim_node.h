@@ -30,6 +30,7 @@
 #include "soft_body_sim/SimConfig.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/ros/anchor_handles.h"
+#include "soft_body_sim/ros/input_glide.h"
 #include "soft_body_sim/ros/input_schedule.h"
 #include "soft_body_sim/ros/reconfigure_server.h"
 #include "soft_body_sim/ros/ros_converter.h"
@@ -169,6 +170,10 @@ private:
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
 
   InputSchedule inputs_;
+  /// ~max_input_interval [s]: each anchor input is reached over the interval since its anchor's previous
+  /// one, at most this long (input_glide.h); 0: in the step its stamp falls in
+  double max_input_interval_ = 0.5;
+  std::map<int, InputGlide> glides_;  ///< per anchor index, once it has had an input
   std::vector<std::string> handle_names_;  ///< per scene anchor: its handle ("" = follows a frame)
   std::vector<std::pair<std::string, std::string>> target_handles_;  ///< (body, handle) per target
   std::vector<std::pair<std::string, Vec3>> targets_;  ///< last target set per body [m]
