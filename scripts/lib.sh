@@ -28,11 +28,12 @@ PACKAGES=(
 )
 # What only the demo needs on top: rviz (already in PACKAGES for the rviz screenshot test).
 DEMO_PACKAGES=(rviz)
-# What scripts/demo builds: the node, the state viewer (play.launch), and all that a client of the running node needs from the build, the
-# package's messages and services (C++, Python, Lisp) and its dynamic_reconfigure code (C++, Python):
-# rostopic, rosservice, grasp_example.py and a user's own code (soft_body_sim.msg, .srv, .cfg, the C++
-# headers) load them. Not `all`, which adds the nodelet, the headless simulator, the benchmarks and the
-# tests' main library (36 s more on two cores); the tests themselves are the `tests` target.
+# What scripts/demo builds: the node, the state viewer (play.launch), and all that a client of the running
+# node needs from the build, the package's messages and services (C++, Python, Lisp) and its
+# dynamic_reconfigure code (C++, Python): rostopic, rosservice, grasp_example.py and a user's own code
+# (soft_body_sim.msg, .srv, .cfg, the C++ headers) load them. Not `all`, which adds the nodelet, the headless
+# simulator, the benchmarks and the tests' main library (36 s more on two cores); the tests themselves are the
+# `tests` target.
 DEMO_TARGETS=(soft_body_sim_node state_viewer soft_body_sim_generate_messages soft_body_sim_gencfg)
 # What only scripts/bench needs on top: Bullet (the peer; Debian builds it in double precision too, as
 # pkg-config bullet-float64), pkg-config to find it, matplotlib for the plots.

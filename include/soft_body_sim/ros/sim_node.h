@@ -170,8 +170,8 @@ private:
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
 
   InputSchedule inputs_;
-  /// ~max_input_interval [s]: each anchor input is reached over the interval since its anchor's previous
-  /// one, at most this long (input_glide.h); 0: in the step its stamp falls in
+  /// ~max_input_interval [s]: the longest an anchor glides to an input (input_glide.h); 0: each input is
+  /// reached in the step its stamp falls in
   double max_input_interval_ = 0.5;
   std::map<int, InputGlide> glides_;  ///< per anchor index, once it has had an input
   std::vector<std::string> handle_names_;  ///< per scene anchor: its handle ("" = follows a frame)
@@ -201,7 +201,7 @@ private:
   };
   std::vector<HeldNode> held_;  ///< as the current tick began
   std::set<std::string> slash_warned_;  ///< sources warned about a frame name's leading slash (tfFrame)
-  double force_scale_ = RosConverter::kForceScale;     ///< ~force_scale [m/N]: length of the force arrows on ~force_markers
+  double force_scale_ = RosConverter::kForceScale;  ///< ~force_scale [m/N]: the arrows on ~force_markers
 };
 
 }  // namespace soft_body_sim
