@@ -187,6 +187,14 @@ bool World::takesTarget(std::size_t body) const
   return false;
 }
 
+std::optional<Vec3> World::target(std::size_t body) const
+{
+  for (const BodyController& c : controllers_)
+    if (static_cast<std::size_t>(c.body) == body)
+      return c.controller->target();
+  return std::nullopt;
+}
+
 bool World::setTarget(const std::string& body, const Vec3& target)
 {
   for (BodyController& c : controllers_)

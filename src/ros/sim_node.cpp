@@ -130,6 +130,7 @@ void SimNode::buildWorldFromScene()
   targets_.clear();
   inputs_.clear();
   glides_.clear();
+  target_glides_.clear();
 }
 
 void SimNode::onTimer(const ros::TimerEvent&)
@@ -266,9 +267,8 @@ void SimNode::publish()
     if (!handle_names_[k].empty())
       handles_->follow(handle_names_[k], state.position.col(world_->model().anchors[k].node));
   for (const auto& [body, handle] : target_handles_)
-    for (const auto& [name, target] : targets_)
-      if (name == body)
-        handles_->follow(handle, target);
+    if (const auto target = targets_.find(body); target != targets_.end())
+      handles_->follow(handle, target->second);
   handles_->applyChanges();
 }
 

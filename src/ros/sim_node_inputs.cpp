@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
 #include <tf2_geometry_msgs/tf2_geometry_msgs.h>
 
@@ -153,42 +154,50 @@ void SimNode::applyDueInputs(const ros::Time& step_end)
 {
   const double start = world_->time(), end = (step_end - epoch_).toSec();
   std::vector<int> given;  // anchors with an input this step
+  std::vector<std::string> aimed;  // bodies with a target this step
   const auto move = [&](int anchor, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation) {
     if (orientation)
       world_->moveAnchor(anchor, position, *orientation);
     else
       world_->moveAnchor(anchor, position);
   };
+  const auto aim = [&](const std::string& body, const Vec3& target) {
+    world_->setTarget(body, target);
+    targets_[body] = target;
+  };
   for (const ScheduledInput& input : inputs_.due(step_end))
   {
+    const double stamp = (input.stamp - epoch_).toSec();
     if (input.kind == ScheduledInput::Kind::Anchor)
     {
       warnIfRodEndJumps(input);
       if (max_input_interval_ > 0.0)
       {
-        glides_[input.anchor].add((input.stamp - epoch_).toSec(), input.position, input.orientation,
-                                  max_input_interval_);
+        glides_[input.anchor].add(stamp, input.position, input.orientation, max_input_interval_);
         given.push_back(input.anchor);
       }
       else
         move(input.anchor, input.position, input.orientation);
       continue;
     }
-    world_->setTarget(input.body, input.position);
-    bool known = false;
-    for (auto& [body, target] : targets_)
-      if (body == input.body)
-      {
-        target = input.position;
-        known = true;
-      }
-    if (!known)
-      targets_.emplace_back(input.body, input.position);
+    if (max_input_interval_ > 0.0)
+    {
+      // A target after a pause starts a move of its own, set at once: the body's dynamics approach it, with
+      // the creature's anticipation (creature.h), which a glide would spread into nothing.
+      target_glides_[input.body].addAfterPauseAtOnce(stamp, input.position, max_input_interval_);
+      aimed.push_back(input.body);
+    }
+    else
+      aim(input.body, input.position);
   }
-  // Every anchor whose commanded pose changes in this step goes where its glide is at the step's end.
+  // Every anchor and target whose commanded pose changes in this step goes where its glide is at the
+  // step's end.
   for (const auto& [anchor, glide] : glides_)
     if (glide.movingAfter(start) || std::find(given.begin(), given.end(), anchor) != given.end())
       move(anchor, glide.positionAt(end), glide.orientationAt(end));
+  for (const auto& [body, glide] : target_glides_)
+    if (glide.movingAfter(start) || std::find(aimed.begin(), aimed.end(), body) != aimed.end())
+      aim(body, glide.positionAt(end));
 }
 
 void SimNode::warnIfRodEndJumps(const ScheduledInput& input) const
@@ -304,11 +313,14 @@ std::string SimNode::outsideWorkspace(const Vec3& position) const
   return text;
 }
 
-std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros::Time& stamp, std::string* why)
+std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros::Time& stamp, std::string* why,
+                                            std::optional<ros::Time>* newest)
 {
   std::string unused;
   std::string& reason = why ? *why : unused;
   geometry_msgs::TransformStamped transform;
+  if (newest)
+    newest->reset();
   try
   {
     try
@@ -323,6 +335,8 @@ std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros:
       transform = tf_buffer_.lookupTransform(scene_.frame_id, frame, ros::Time(0));
       if (transform.header.stamp >= stamp)
         throw tf2::LookupException("its first transform is stamped after this step");
+      if (newest)
+        *newest = transform.header.stamp;
     }
   }
   catch (const tf2::TransformException& e)
@@ -361,10 +375,26 @@ std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Ti
   return pose ? std::optional<Vec3>(pose->position) : std::nullopt;
 }
 
+std::optional<RigidPose> SimNode::followedPose(const std::string& frame, double t, InputGlide& glide)
+{
+  std::optional<ros::Time> newest;
+  const std::optional<RigidPose> pose = framePose(frame, rosTime(t), nullptr, &newest);
+  if (!pose)
+    return std::nullopt;
+  // world_->time() is the step's start: a late frame's newest transform glides in from there.
+  glide.follow(world_->time(), t, pose->position, pose->orientation,
+               newest ? std::optional<double>((*newest - epoch_).toSec()) : std::nullopt, max_input_interval_);
+  return RigidPose{ glide.positionAt(t), *glide.orientationAt(t) };
+}
+
 void SimNode::followFrame(int anchor, const std::string& frame)
 {
   // The path is asked for the step's end: the frame's pose at that ROS time, interpolated by tf.
-  world_->followPath(anchor, [this, frame](double t) { return frameOrigin(frame, rosTime(t)); });
+  const auto glide = std::make_shared<InputGlide>();
+  world_->followPath(anchor, [this, frame, glide](double t) -> std::optional<Vec3> {
+    const std::optional<RigidPose> pose = followedPose(frame, t, *glide);
+    return pose ? std::optional<Vec3>(pose->position) : std::nullopt;
+  });
 }
 
 void SimNode::followFrame(const ColliderPlacement& collider)
@@ -372,8 +402,9 @@ void SimNode::followFrame(const ColliderPlacement& collider)
   // The scene's pose of the collider is relative to its frame.
   const RigidPose local{ collider.position, collider.orientation };
   const std::string frame = collider.frame;
-  world_->followColliderPath(collider.name, [this, frame, local](double t) -> std::optional<RigidPose> {
-    const std::optional<RigidPose> origin = framePose(frame, rosTime(t));
+  const auto glide = std::make_shared<InputGlide>();
+  world_->followColliderPath(collider.name, [this, frame, local, glide](double t) -> std::optional<RigidPose> {
+    const std::optional<RigidPose> origin = followedPose(frame, t, *glide);
     if (!origin)
       return std::nullopt;
     return RigidPose{ origin->position + origin->orientation * local.position, origin->orientation * local.orientation };
@@ -487,7 +518,8 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
     return refuse(e.what());
   }
   const std::string frame = request.frame;
-  world_->followGraspPath(frame, [this, frame](double t) { return framePose(frame, rosTime(t)); });
+  const auto glide = std::make_shared<InputGlide>();
+  world_->followGraspPath(frame, [this, frame, glide](double t) { return followedPose(frame, t, *glide); });
   const GraspedNodes& grasp = world_->grasps().back();
   const int first = world_->model().bodies[grasp.body].first;
   for (const int node : grasp.nodes)

@@ -102,6 +102,8 @@ SimState RosConverter::toState(const World& world, const std::string& frame_id, 
         wrench.torque = toVector3(holder.wrench.torque);
         body.wrenches.push_back(wrench);
       }
+    if (const std::optional<Vec3> target = world.target(b))
+      body.target.push_back(toPoint(*target));
     for (const GraspSlip& slip : slips)
       if (slip.body == range.name)
         body.slips.push_back(slip.describe());

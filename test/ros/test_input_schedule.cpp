@@ -293,5 +293,87 @@ TEST(InputGlide, AnOrientationTurnsBySlerpWithThePosition)
   EXPECT_FALSE(glide.orientationAt(0.35));
 }
 
+TEST(InputGlide, AnInputAfterAPauseIsReachedAtOnceWhereATargetStartsAMoveOfItsOwn)
+{
+  InputGlide glide;
+  glide.addAfterPauseAtOnce(0.0, Vec3::Zero(), 0.25);
+  glide.addAfterPauseAtOnce(0.05, Vec3(0.1, 0, 0), 0.25);  // within the stream: glides
+  EXPECT_NEAR(glide.positionAt(0.075).x(), 0.05, 1e-15);
+  glide.addAfterPauseAtOnce(10.0, Vec3(1, 0, 0), 0.25);  // after 10 s: at once
+  EXPECT_EQ(glide.positionAt(10.0), Vec3(1, 0, 0));
+  EXPECT_FALSE(glide.movingAfter(10.0));
+}
+
+// --- a holder on a tf frame (InputGlide::follow) ---
+
+/// The fastest [m/s] a holder moves from 5 ms step to step over 4 s while its tf frame runs along a circle
+/// of 0.25 m (one turn in 4 s, 0.39 m/s), broadcast at 20 Hz stamped `lead` [s] ahead of the instant it
+/// is for and seen by the first step that ends `latency` [s] or more after it is sent (negative lead: late).
+double fastestHolder(double lead, double latency, double max_interval)
+{
+  const double radius = 0.25, omega = 2.0 * M_PI / 4.0, period = 0.05, dt = 0.005;
+  const auto path = [&](double t) { return Vec3(radius * std::cos(omega * t), 0.0, radius * std::sin(omega * t)); };
+  // tf's interpolation between the transforms it has at `seen` (sent at stamp - lead, one per period).
+  const auto look = [&](double t, double seen, std::optional<double>& newest) {
+    const double sent = std::floor((seen - latency) / period + 1e-9) * period;  // the last one sent by then
+    const double last = sent + lead;
+    if (t <= last)
+    {
+      newest.reset();
+      const double k = std::floor(t / period);
+      const double s = t / period - k;
+      return Vec3((1.0 - s) * path(k * period) + s * path((k + 1) * period));
+    }
+    newest = last;
+    return path(last);
+  };
+  InputGlide glide;
+  double fastest = 0.0;
+  Vec3 previous = path(0.0);
+  for (int j = 1; j <= 800; ++j)
+  {
+    const double start = (j - 1) * dt, end = j * dt;
+    std::optional<double> newest;
+    const Vec3 at = look(end, end, newest);
+    glide.follow(start, end, at, Eigen::Quaterniond::Identity(), newest, max_interval);
+    const Vec3 now = glide.positionAt(end);
+    if (j > 20)
+      fastest = std::max(fastest, (now - previous).norm() / dt);
+    previous = now;
+  }
+  return fastest / (radius * omega);
+}
+
+TEST(InputGlide, AHolderOnALateFrameGlidesAtTheFramesSpeedWhereReachingEachTransformJumped)
+{
+  // Stamped now and seen 1 ms later, as robot_state_publisher's or a driver's frames are: each step
+  // ends past the newest transform.
+  EXPECT_LE(fastestHolder(0.0, 0.001, 0.5), 1.0 + 1e-9);
+  EXPECT_GT(fastestHolder(0.0, 0.001, 0.5), 0.99);
+  // ~max_input_interval 0: each transform reached in the step that sees it, 2 cm in 5 ms (ten times).
+  EXPECT_GT(fastestHolder(0.0, 0.001, 0.0), 9.0);
+  // Stamped 0.1 s ahead (send_targets.py's lead): tf interpolates at each step's end, exactly.
+  EXPECT_LE(fastestHolder(0.1, 0.001, 0.5), 1.0 + 1e-9);
+  EXPECT_EQ(fastestHolder(0.1, 0.001, 0.5), fastestHolder(0.1, 0.001, 0.0));
+}
+
+TEST(InputGlide, AFrameThatFallsBehindGoesOnAlongItsPathFromTheExactPose)
+{
+  // Exact at 1.0 (tf had both sides), then tf's newest is stamped 1.02 when the step to 1.025 ends: the
+  // holder goes on along the path, reaching 1.02's pose at 1.02, and holds it while nothing newer comes.
+  InputGlide glide;
+  glide.follow(0.995, 1.0, Vec3(1, 0, 0), Eigen::Quaterniond::Identity(), std::nullopt, 0.5);
+  EXPECT_EQ(glide.positionAt(1.0), Vec3(1, 0, 0));
+  glide.follow(1.0, 1.025, Vec3(1.02, 0, 0), Eigen::Quaterniond::Identity(), 1.02, 0.5);
+  EXPECT_NEAR(glide.positionAt(1.01).x(), 1.01, 1e-12);
+  EXPECT_EQ(glide.positionAt(1.025), Vec3(1.02, 0, 0));
+  glide.follow(1.025, 1.03, Vec3(1.02, 0, 0), Eigen::Quaterniond::Identity(), 1.02, 0.5);
+  EXPECT_EQ(glide.positionAt(1.03), Vec3(1.02, 0, 0));
+  // The next, stamped 1.07 and seen in the step from 1.08: 5 cm in 0.05 s, glided over 0.05 s from 1.08.
+  glide.follow(1.08, 1.085, Vec3(1.07, 0, 0), Eigen::Quaterniond::Identity(), 1.07, 0.5);
+  EXPECT_NEAR(glide.positionAt(1.105).x(), 1.045, 1e-12);
+  EXPECT_EQ(glide.positionAt(1.14), Vec3(1.07, 0, 0));
+}
+
 }  // namespace
 }  // namespace soft_body_sim

@@ -81,8 +81,9 @@ class InputsTest(NodeTestCase):
         return wait_for(lambda: any(m.level == level and all(t in m.msg for t in texts) for m in self.log[start:]), 10.0)
 
     def test_an_anchor_follows_its_tf_frame(self):
-        # Each step's end asks tf for the frame at that instant (the latest transform when the step is
-        # ahead of tf's data, up to one 20 ms broadcast period plus transport: 0.16 m/s * 50 ms = 8 mm).
+        # Each step's end asks tf for the frame at that instant. The broadcasts are stamped now, so steps end
+        # past the newest transform, which glides in over its 20 ms period from the step that sees it
+        # (input_glide.h): behind by a period and the transport, 0.16 m/s * 50 ms = 8 mm.
         self.state.next(25)
         errors = []
         for _ in range(50):

@@ -84,6 +84,8 @@ public:
   bool setTarget(const std::string& body, const Vec3& target);
   /// True if body `body` (index into model().bodies) takes a target.
   bool takesTarget(std::size_t body) const;
+  /// The point [m] body `body` (index into model().bodies) moves toward now, if it takes a target.
+  std::optional<Vec3> target(std::size_t body) const;
 
   /// The current pose of every placed drawable collider, by kind (spheres, capsules, boxes, cylinders,
   /// meshes), each kind in declaration order.

@@ -1,4 +1,5 @@
-// Smooth streamed inputs: an anchor's commanded pose between its stamped inputs.
+// Smooth streamed inputs: the commanded pose of an anchor, a target or a holder on a tf frame between its
+// stamped inputs.
 //
 // A pose streamed at 20 Hz and reached within one step leaves the anchor jumping 2 cm in 5 ms and resting
 // 45 ms. Here each input is reached at the speed its stamp implies: the distance from the previous input
@@ -16,6 +17,9 @@
 //   (one far behind its stream catches up faster), and an input that only turns takes its interval.
 // - A late input (stamped before the step it reaches) starts its glide at its stamp, as if on time: the
 //   step it reaches puts the anchor where the glide is by then.
+// - A tf frame is its own stream (SimNode::framePose): where tf has transforms on both sides of a step's
+//   end, tf's interpolation there is exact and smooth (`place`); past the frame's newest transform, each
+//   newer one glides from the step that first sees it (`addSeenAt`), rather than being reached in that step.
 // Plain data: unit-testable without a master.
 #pragma once
 
@@ -32,12 +36,22 @@ public:
   /// An input stamped `t` [s of simulated time] toward `position` [m] and, if given, `orientation`.
   void add(double t, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation, double max_interval)
   {
-    const double interval = started_ ? std::min(t - last_stamp_, max_interval) : 0.0;
+    addSeenAt(t, t, position, orientation, max_interval);
+  }
+
+  /// An input stamped `stamp` but seen only at `start` [s], after its stamp (a tf frame's newest
+  /// transform, when the frame is published late): it glides from where the glide is at `start`, at the
+  /// stream's speed, so it arrives about one interval after `start`. Not for replays: when a late
+  /// input is seen depends on when it came.
+  void addSeenAt(double stamp, double start, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation,
+                 double max_interval)
+  {
+    const double interval = started_ ? std::min(stamp - last_stamp_, max_interval) : 0.0;
     double duration = 0.0;
     if (interval > 0.0)
     {
-      from_ = positionAt(t);
-      from_orientation_ = orientation && to_orientation_ ? orientationAt(t) : orientation;
+      from_ = positionAt(start);
+      from_orientation_ = orientation && to_orientation_ ? orientationAt(start) : orientation;
       const double speed = (position - to_).norm() / interval;  // the stream's, from the previous input
       const double distance = (position - from_).norm();
       duration = speed > 0.0 ? std::min(distance / speed, max_interval) : interval;
@@ -49,10 +63,42 @@ public:
     }
     to_ = position;
     to_orientation_ = orientation;
-    from_time_ = t;
-    to_time_ = t + duration;
-    last_stamp_ = t;
+    from_time_ = start;
+    to_time_ = start + duration;
+    last_stamp_ = stamp;
     started_ = true;
+  }
+
+  /// The pose is known exactly at time t (a tf frame's transform interpolated there): it is there, at
+  /// rest, and counts as an input stamped t for the speed of the next.
+  void place(double t, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation)
+  {
+    from_ = to_ = position;
+    from_orientation_ = to_orientation_ = orientation;
+    from_time_ = to_time_ = last_stamp_ = t;
+    started_ = true;
+  }
+
+  /// One step, from `start` to `end` [s], of a holder on a tf frame, given the frame's pose from tf: its pose
+  /// at `end` where `newest` is nullopt (tf had transforms on both sides of `end`), else its newest
+  /// transform, stamped `newest` (the frame is late). positionAt(end) and orientationAt(end) are then the
+  /// holder's: tf's exact pose, or where the newest transform glides in from the step that first saw it.
+  void follow(double start, double end, const Vec3& position, const Eigen::Quaterniond& orientation,
+              const std::optional<double>& newest, double max_interval)
+  {
+    if (!newest)
+      place(end, position, orientation);
+    else if (!started_ || *newest > last_stamp_)
+      addSeenAt(*newest, start, position, orientation, max_interval);
+  }
+
+  /// As add, except that an input after a pause longer than `max_interval` starts a new stream, reached
+  /// at once: a target's, which the body's own dynamics approach.
+  void addAfterPauseAtOnce(double t, const Vec3& position, double max_interval)
+  {
+    if (started_ && t - last_stamp_ > max_interval)
+      started_ = false;
+    add(t, position, std::nullopt, max_interval);
   }
 
   /// The commanded position [m] at time t [s]: exactly the input's once the glide has ended.

@@ -90,8 +90,14 @@ private:
   std::string tfFrame(const std::string& frame, const std::string& source);
   /// The pose of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf has
   /// none that recent yet); nullopt with a throttled warning if tf has none at all, or one that is not
-  /// finite or beyond ~workspace_radius; `why`, if given, is set to the reason.
-  std::optional<RigidPose> framePose(const std::string& frame, const ros::Time& stamp, std::string* why = nullptr);
+  /// finite or beyond ~workspace_radius; `why`, if given, is set to the reason; `newest`, if given, to the
+  /// latest transform's stamp when that was used (the frame is late), to nullopt when tf interpolated.
+  std::optional<RigidPose> framePose(const std::string& frame, const ros::Time& stamp, std::string* why = nullptr,
+                                     std::optional<ros::Time>* newest = nullptr);
+  /// The pose of a holder or collider following `frame` at the end of the step that ends at simulated
+  /// time t [s]: tf's where it has transforms on both sides of t, else where `glide` has the newest
+  /// transform gliding in since the step that first saw it (input_glide.h; ~max_input_interval).
+  std::optional<RigidPose> followedPose(const std::string& frame, double t, InputGlide& glide);
   /// framePose's position.
   std::optional<Vec3> frameOrigin(const std::string& frame, const ros::Time& stamp, std::string* why = nullptr);
   /// Makes anchor `anchor` follow tf frame `frame` every step.
@@ -170,13 +176,14 @@ private:
   std::unique_ptr<diagnostic_updater::Updater> diagnostics_;
 
   InputSchedule inputs_;
-  /// ~max_input_interval [s]: the longest an anchor glides to an input (input_glide.h); 0: each input is
-  /// reached in the step its stamp falls in
+  /// ~max_input_interval [s]: the longest an anchor, a target or a holder on a late tf frame glides to an
+  /// input (input_glide.h); 0: each input is reached in the step its stamp falls in
   double max_input_interval_ = 0.5;
   std::map<int, InputGlide> glides_;  ///< per anchor index, once it has had an input
+  std::map<std::string, InputGlide> target_glides_;  ///< per body, once it has had a target
   std::vector<std::string> handle_names_;  ///< per scene anchor: its handle ("" = follows a frame)
   std::vector<std::pair<std::string, std::string>> target_handles_;  ///< (body, handle) per target
-  std::vector<std::pair<std::string, Vec3>> targets_;  ///< last target set per body [m]
+  std::map<std::string, Vec3> targets_;  ///< last target set per body [m]
 
   bool started_ = false;
   std::optional<ros::Time> start_time_;  ///< ~start_time: the ROS time of simulated time 0, if given

@@ -102,6 +102,9 @@ public:
     return true;
   }
 
+  /// The target as the lead steers to it: in the swimming plane.
+  std::optional<Vec3> target() const override { return target_; }
+
   /// The body outline: lead, left side, orientation point, right side, lead.
   std::vector<std::vector<Vec3>> curves(const State& state) const override
   {

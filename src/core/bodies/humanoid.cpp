@@ -105,6 +105,8 @@ public:
     return true;
   }
 
+  std::optional<Vec3> target() const override { return target_; }
+
   /// The spine (pelvis, neck, head), the shoulders, the hips and the four limbs' Bezier curves.
   std::vector<std::vector<Vec3>> curves(const State& state) const override
   {

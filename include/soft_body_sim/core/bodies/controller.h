@@ -5,6 +5,7 @@
 
 #include <functional>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
@@ -36,6 +37,8 @@ public:
     (void)target;
     return false;
   }
+  /// The point [m] the body moves toward now, if it takes a target.
+  virtual std::optional<Vec3> target() const { return std::nullopt; }
   /// Polylines [m] to draw for this body beyond its nodes and springs (a limb's sampled Bezier curve).
   virtual std::vector<std::vector<Vec3>> curves(const State& state) const
   {
