@@ -320,9 +320,9 @@ double fastestHolder(double lead, double latency, double max_interval)
     if (t <= last)
     {
       newest.reset();
-      const double k = std::floor(t / period);
-      const double s = t / period - k;
-      return Vec3((1.0 - s) * path(k * period) + s * path((k + 1) * period));
+      const double k = std::floor((t - lead) / period);
+      const double s = (t - lead) / period - k;
+      return Vec3((1.0 - s) * path(k * period + lead) + s * path((k + 1) * period + lead));
     }
     newest = last;
     return path(last);
@@ -355,6 +355,10 @@ TEST(InputGlide, AHolderOnALateFrameGlidesAtTheFramesSpeedWhereReachingEachTrans
   // Stamped 0.1 s ahead (send_targets.py's lead): tf interpolates at each step's end, exactly.
   EXPECT_LE(fastestHolder(0.1, 0.001, 0.5), 1.0 + 1e-9);
   EXPECT_EQ(fastestHolder(0.1, 0.001, 0.5), fastestHolder(0.1, 0.001, 0.0));
+  // Stamped 2 ms ahead and seen at once: the step that sees a transform ends before its stamp, the next
+  // nine after it. Late and not late in turn, it glides on rather than jumping back onto tf's pose.
+  EXPECT_LE(fastestHolder(0.002, 0.0, 0.5), 1.0 + 1e-9);
+  EXPECT_GT(fastestHolder(0.002, 0.0, 0.0), 9.0);
 }
 
 TEST(InputGlide, AFrameThatFallsBehindGoesOnAlongItsPathFromTheExactPose)

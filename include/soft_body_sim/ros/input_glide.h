@@ -17,9 +17,12 @@
 //   (one far behind its stream catches up faster), and an input that only turns takes its interval.
 // - A late input (stamped before the step it reaches) starts its glide at its stamp, as if on time: the
 //   step it reaches puts the anchor where the glide is by then.
-// - A tf frame is its own stream (SimNode::framePose): where tf has transforms on both sides of a step's
-//   end, tf's interpolation there is exact and smooth (`place`); past the frame's newest transform, each
-//   newer one glides from the step that first sees it (`addSeenAt`), rather than being reached in that step.
+// - A tf frame is its own stream (`follow`): where tf has transforms on both sides of a step's end (the
+//   frame is published ahead), tf's interpolation there is exact and smooth; past the frame's newest
+//   transform (late), each newer one glides in from the step that first sees it, rather than being
+//   reached in that step, and the holder stays a glide until it rests on tf's pose. When a late
+//   transform is seen depends on when it came: a replay is exact only for frames published ahead.
+// - A target after a pause longer than `max_interval` starts afresh, at once (`addAfterPauseAtOnce`).
 // Plain data: unit-testable without a master.
 #pragma once
 
@@ -82,14 +85,28 @@ public:
   /// One step, from `start` to `end` [s], of a holder on a tf frame, given the frame's pose from tf: its pose
   /// at `end` where `newest` is nullopt (tf had transforms on both sides of `end`), else its newest
   /// transform, stamped `newest` (the frame is late). positionAt(end) and orientationAt(end) are then the
-  /// holder's: tf's exact pose, or where the newest transform glides in from the step that first saw it.
+  /// holder's: where the newest transform glides in from the step that first saw it, or tf's exact pose.
+  /// Once it has glided, tf's poses glide in too, each stamped its step's end, until the holder comes to
+  /// rest on tf's pose (the frame stopped): a frame stamped about when its steps end is late for one step
+  /// and not for the next, and a holder put on tf's pose there would jump the interval it is behind.
   void follow(double start, double end, const Vec3& position, const Eigen::Quaterniond& orientation,
               const std::optional<double>& newest, double max_interval)
   {
-    if (!newest)
+    if (newest)
+    {
+      if (!started_ || *newest > last_stamp_)
+        addSeenAt(*newest, start, position, orientation, max_interval);
+      on_frame_ = false;
+      return;
+    }
+    const bool same = to_ == position && to_orientation_ && to_orientation_->coeffs() == orientation.coeffs();
+    if (!started_ || on_frame_ || (same && !movingAfter(start)))
+    {
       place(end, position, orientation);
-    else if (!started_ || *newest > last_stamp_)
-      addSeenAt(*newest, start, position, orientation, max_interval);
+      on_frame_ = true;
+    }
+    else if (!same)  // a frame at rest adds nothing: the glide ends on it at the speed it had
+      addSeenAt(end, start, position, orientation, max_interval);
   }
 
   /// As add, except that an input after a pause longer than `max_interval` starts a new stream, reached
@@ -127,6 +144,7 @@ private:
   }
 
   bool started_ = false;
+  bool on_frame_ = false;  ///< follow: placed on tf's exact pose in the last step
   double last_stamp_ = 0.0;  ///< [s] of the last input
   double from_time_ = 0.0, to_time_ = 0.0;  ///< [s]
   Vec3 from_ = Vec3::Zero(), to_ = Vec3::Zero();  ///< [m]
