@@ -15,7 +15,7 @@ PACKAGES=(
   libvisualization-msgs-dev ros-visualization-msgs libstd-srvs-dev ros-std-srvs
   libroscpp-dev libtf2-ros-dev libtf2-geometry-msgs-dev ros-tf2-msgs
   python3-rostest librostest-dev python3-roslaunch python3-rostopic python3-rosbag
-  libeigen3-dev libyaml-cpp-dev libopenvdb-dev libassimp-dev libroslib-dev
+  libeigen3-dev libyaml-cpp-dev libopenvdb-dev libassimp-dev libroslib-dev libembree-dev libpng-dev
   tetgen
   googletest libgtest-dev libbenchmark-dev
   clang libclang-rt-14-dev

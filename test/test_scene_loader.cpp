@@ -234,7 +234,7 @@ const BadScene kBadScenes[] = {
   { "UnknownTopLevelKey", R"(frame: world
 bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 0], mass: 1}]}]
 )",
-    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, rate, physics, planes, colliders, robot_colliders, bodies" } },
+    "bad.yaml:1: frame", { "unknown key 'frame'", "frame_id, rate, physics, planes, colliders, robot_colliders, cameras, bodies" } },
   { "UnknownPhysicsKey", R"(physics:
   dt: 0.01
   timestep: 0.01
@@ -794,7 +794,7 @@ bodies: []
   { "TopLevelIsAList", R"(- name: b
   type: custom
 )",
-    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, rate, physics, planes, colliders, robot_colliders, bodies", "a list" } },
+    "bad.yaml:1: (top level)", { "must be a YAML mapping", "frame_id, rate, physics, planes, colliders, robot_colliders, cameras, bodies", "a list" } },
   { "TopLevelIsAScalar", R"(hello
 )",
     "bad.yaml:1: (top level)", { "must be a YAML mapping", "'hello'" } },
@@ -1119,6 +1119,84 @@ TEST(SceneLoader, BadCollidersAreRejectedWithOneLineAtTheKey)
   expectSceneError("bodies: [{name: r, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1, "
                    "radius: -0.1}]\n",
                    "bad.yaml:1: bodies[0].radius", { "radius must be >= 0", "-0.1" });
+}
+
+TEST(SceneLoader, CamerasAndColoursAreReadWithTheirDefaults)
+{
+  const SceneDef scene = parseScene(
+      "planes: [{point: [0, 0, 0], normal: [0, 0, 1], color: [0.1, 0.2, 0.3]}]\n"
+      "colliders: [{name: ball, shape: sphere, radius: 0.1, color: [1, 0, 0]}]\n"
+      "cameras:\n"
+      "  - {name: camera, position: [1.2, 0, 1], orientation: [0, 0.2588, 0, 0.9659], width: 320, height: 240,\n"
+      "     horizontal_fov: 90, rate: 15, min_range: 0.2, max_range: 4, background: [0, 0, 1],\n"
+      "     noise: {depth_stddev: 0.001, seed: 7}}\n"
+      "  - {name: wrist, frame: wrist_link}\n"
+      "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}], color: [0, 1, 0]},\n"
+      "         {name: c, type: rope, nodes: 3, from: [0, 0, 1], to: [1, 0, 1], mass: 1, stiffness: 1}]\n",
+      "cameras.yaml");
+  EXPECT_EQ(scene.colliders.planes[0].color, Vec3(0.1, 0.2, 0.3));
+  EXPECT_EQ(scene.colliders.spheres[0].at.color, Vec3(1, 0, 0));
+  ASSERT_EQ(scene.cameras.size(), 2u);
+  const CameraDef& camera = scene.cameras[0];
+  EXPECT_EQ(camera.name, "camera");
+  EXPECT_EQ(camera.position, Vec3(1.2, 0, 1));
+  EXPECT_EQ(camera.orientation.coeffs(), Eigen::Vector4d(0, 0.2588, 0, 0.9659));
+  EXPECT_EQ(camera.width, 320);
+  EXPECT_EQ(camera.height, 240);
+  EXPECT_EQ(camera.horizontal_fov, 90.0);
+  EXPECT_EQ(camera.rate, 15.0);
+  EXPECT_EQ(camera.min_range, 0.2);
+  EXPECT_EQ(camera.max_range, 4.0);
+  EXPECT_EQ(camera.background, Vec3(0, 0, 1));
+  ASSERT_TRUE(camera.noise);
+  EXPECT_EQ(camera.noise->depth_stddev, 0.001);
+  EXPECT_EQ(camera.noise->seed, 7u);
+  const CameraDef& wrist = scene.cameras[1];  // the contract's defaults
+  EXPECT_EQ(wrist.frame, "wrist_link");
+  EXPECT_EQ(wrist.width, 640);
+  EXPECT_EQ(wrist.height, 480);
+  EXPECT_EQ(wrist.horizontal_fov, 69.4);
+  EXPECT_EQ(wrist.rate, 30.0);
+  EXPECT_EQ(wrist.min_range, 0.1);
+  EXPECT_EQ(wrist.max_range, 10.0);
+  EXPECT_EQ(wrist.background, Vec3::Constant(0.2));
+  EXPECT_FALSE(wrist.noise);
+  // 640 px over 69.4 degrees: fx = 320 / tan(34.7 deg) = 462.1 px, the centre between the middle pixels.
+  const CameraIntrinsics k = CameraIntrinsics::of(wrist);
+  EXPECT_NEAR(k.fx, 320.0 / std::tan(34.7 * M_PI / 180.0), 1e-9);
+  EXPECT_EQ(k.fy, k.fx);
+  EXPECT_EQ(k.cx, 319.5);
+  EXPECT_EQ(k.cy, 239.5);
+  // A body's colour, else the golden-angle default by its index; its look from its type.
+  const World world = buildWorld(scene);
+  EXPECT_EQ(world.model().bodies[0].look.color, Vec3(0, 1, 0));
+  EXPECT_EQ(world.model().bodies[1].look.color, defaultBodyColor(1));
+  EXPECT_EQ(world.model().bodies[0].look.balls, std::vector<int>{ 0 });
+  EXPECT_EQ(world.model().bodies[1].look.tubes.size(), 2u);  // the rope's two links
+  EXPECT_EQ(world.model().bodies[1].look.radius, kDefaultLookRadius);
+}
+
+TEST(SceneLoader, BadCamerasAndColoursAreRejectedWithOneLineAtTheKey)
+{
+  const std::string body = "bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}]}]\n";
+  expectSceneError("cameras: [{name: c, width: 0}]\n" + body, "bad.yaml:1: cameras[0].width", { "integer in [1," });
+  expectSceneError("cameras: [{name: c, horizontal_fov: 180}]\n" + body, "bad.yaml:1: cameras[0].horizontal_fov",
+                   { "between 0 and 180" });
+  expectSceneError("cameras: [{name: c, min_range: 2, max_range: 1}]\n" + body, "bad.yaml:1: cameras[0].max_range",
+                   { "greater than min_range" });
+  expectSceneError("cameras: [{name: c, frame: /hand}]\n" + body, "bad.yaml:1: cameras[0].frame",
+                   { "must not start with '/'" });
+  expectSceneError("cameras: [{name: 'my camera'}]\n" + body, "bad.yaml:1: cameras[0].name",
+                   { "letters, digits and underscores" });
+  expectSceneError("cameras: [{name: c}, {name: c}]\n" + body, "bad.yaml:1: cameras[1].name",
+                   { "duplicate camera name 'c'" });
+  expectSceneError("cameras: [{name: c, noise: {depth_stddev: -1}}]\n" + body,
+                   "bad.yaml:1: cameras[0].noise.depth_stddev", { ">= 0" });
+  expectSceneError("cameras: [{name: c, zoom: 2}]\n" + body, "bad.yaml:1: cameras[0].zoom", { "unknown key" });
+  expectSceneError("colliders: [{name: a, shape: sphere, radius: 1, color: [1, 0, 2]}]\n" + body,
+                   "bad.yaml:1: colliders[0].color", { "each from 0 to 1" });
+  expectSceneError("bodies: [{name: b, type: custom, nodes: [{position: [0, 0, 1], mass: 1}], color: [1, 0]}]\n",
+                   "bad.yaml:1: bodies[0].color", {});
 }
 
 TEST(SceneLoader, APlaneTakesAnOptionalName)

@@ -1,6 +1,7 @@
 // The headless simulator's command-line contract (other tools drive it): CSV layout, row times,
 // precision, overrides, and one-line errors with a non-zero status.
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -8,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "soft_body_sim/tools/camera_images.h"
 #include "soft_body_sim/tools/simulate.h"
 #include "test_util.h"
 
@@ -207,6 +209,38 @@ planes:
   EXPECT_NEAR(std::stod(tension_rows[3][6]), 0.5 * 9.81, 1e-9);
 }
 
+TEST(Simulate, ImagesWritesEachCamerasFramesAtItsRateAsPngs)
+{
+  // A camera at rate 10 Hz over 0.25 s: frames 0, 1 and 2 (t = 0, 0.1, 0.2). It looks along +x at a box's
+  // face 1.5 m away, which fills its 21 x 11 px: every depth 1500 mm, every mask 1000 (the box). A camera on
+  // a tf frame takes none, with a note.
+  const std::string scene = writeScene("camera.yaml", R"(
+physics: {integrator: semi_implicit_euler, dt: 0.05}
+colliders: [{name: wall, shape: box, size: [0.2, 10, 10], position: [1.6, 0, 1]}]
+cameras:
+  - {name: eye, position: [0, 0, 1], width: 21, height: 11, rate: 10}
+  - {name: wrist, frame: hand}
+bodies: [{name: b, type: custom, nodes: [{position: [-5, 0, 1], mass: 1, pinned: true}]}]
+)");
+  const std::string directory = ::testing::TempDir() + "images";
+  std::filesystem::create_directories(directory);
+  const Outcome r = runWith({ "--scene", scene, "--duration", "0.25", "--images", directory });
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("camera 'wrist' rides on tf frame 'hand'"), std::string::npos) << r.err;
+  for (const char* frame : { "000000", "000001", "000002" })
+  {
+    const GreyImage16 depth = readGreyPng16(directory + "/eye_depth_" + frame + ".png");
+    ASSERT_EQ(depth.width, 21);
+    ASSERT_EQ(depth.height, 11);
+    for (const std::uint16_t mm : depth.samples)
+      ASSERT_EQ(mm, 1500);
+    for (const std::uint16_t mask : readGreyPng16(directory + "/eye_mask_" + frame + ".png").samples)
+      ASSERT_EQ(mask, 1000);
+    EXPECT_TRUE(std::filesystem::exists(directory + "/eye_color_" + std::string(frame) + ".png"));
+  }
+  EXPECT_FALSE(std::filesystem::exists(directory + "/eye_depth_000003.png"));
+}
+
 struct BadInput
 {
   const char* name;
@@ -249,7 +283,9 @@ INSTANTIATE_TEST_SUITE_P(
                       BadInput{ "MissingSceneFile", { "--scene", "/nonexistent/scene.yaml" }, "/nonexistent/scene.yaml: cannot open" },
                       BadInput{ "UnwritableCsv", { "--scene", "SCENE", "--csv", "/nonexistent/out.csv" }, "--csv: cannot write" },
                       BadInput{ "UnwritableForces", { "--scene", "SCENE", "--forces", "/nonexistent/f.csv" }, "--forces: cannot write" },
-                      BadInput{ "GivenTwice", { "--scene", "SCENE", "--dt", "1", "--dt", "2" }, "--dt: given twice" }),
+                      BadInput{ "GivenTwice", { "--scene", "SCENE", "--dt", "1", "--dt", "2" }, "--dt: given twice" },
+                      BadInput{ "NoImageDirectory", { "--scene", "SCENE", "--images", "/nonexistent" }, "--images: no directory" },
+                      BadInput{ "ImagesWithoutCameras", { "--scene", "SCENE", "--images", "/tmp" }, "--images: the scene declares no cameras" }),
     [](const ::testing::TestParamInfo<BadInput>& info) { return std::string(info.param.name); });
 
 }  // namespace

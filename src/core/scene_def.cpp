@@ -25,6 +25,42 @@ int globalIndex(const BodyDef& body, int first, int local)
   return first + local;
 }
 
+/// How body `index` of the scene looks (Look): its faces, else its solid surface, else its contact
+/// segments, else its links; its other nodes as balls. `first` is its first global node.
+Look lookOf(const BodyDef& body, std::size_t index, int first, const std::vector<std::array<int, 3>>& surface)
+{
+  Look look;
+  look.radius = body.contact_radius > 0.0 ? body.contact_radius : kDefaultLookRadius;
+  look.color = body.color.value_or(defaultBodyColor(index));
+  const auto global = [&](int local) { return globalIndex(body, first, local); };
+  for (const std::array<int, 3>& face : body.faces)
+    look.faces.push_back({ global(face[0]), global(face[1]), global(face[2]) });
+  if (look.faces.empty())
+    look.faces = surface;
+  if (look.faces.empty())
+  {
+    for (const auto& [a, b] : body.contact_segments)
+      look.tubes.emplace_back(global(a), global(b));
+    if (look.tubes.empty())
+    {
+      for (const SpringDef& spring : body.springs)
+        look.tubes.emplace_back(global(spring.a), global(spring.b));
+      for (const ConstraintDef& constraint : body.constraints)
+        look.tubes.emplace_back(global(constraint.a), global(constraint.b));
+    }
+  }
+  std::vector<bool> seen(body.nodes.size(), false);
+  for (const std::array<int, 3>& face : look.faces)
+    for (const int node : face)
+      seen[static_cast<std::size_t>(node - first)] = true;
+  for (const auto& [a, b] : look.tubes)
+    seen[static_cast<std::size_t>(a - first)] = seen[static_cast<std::size_t>(b - first)] = true;
+  for (std::size_t k = 0; k < seen.size(); ++k)
+    if (!seen[k])
+      look.balls.push_back(first + static_cast<int>(k));
+  return look;
+}
+
 double restLengthOr(const std::optional<double>& rest_length, const State& state, int a, int b)
 {
   return rest_length ? *rest_length : (state.position.col(a) - state.position.col(b)).norm();
@@ -225,9 +261,9 @@ World buildWorld(const SceneDef& scene)
     if (custom)
       requireSelfContact("body '" + body.name + "'", body.self_collision, body.self_friction, body.contact_radius,
                          "contact_radius");
-    model.bodies.push_back(
-        { body.name, first, count, body.self_collision, body.self_friction, body.springs_collide, std::move(surface),
-          body.surface_friction });
+    Look look = lookOf(body, model.bodies.size(), first, surface);
+    model.bodies.push_back({ body.name, first, count, body.self_collision, body.self_friction, body.springs_collide,
+                             std::move(surface), body.surface_friction, std::move(look) });
     first += count;
   }
   try

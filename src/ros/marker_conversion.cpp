@@ -15,18 +15,14 @@ namespace
 constexpr double kNodeDiameter = 0.02;  // [m] sphere size in rviz
 constexpr double kLineWidth = 0.005;    // [m]
 
-/// A distinct, stable colour per body index (golden-angle hues).
-std_msgs::ColorRGBA bodyColor(std::size_t body)
+/// An opaque rviz colour of rgb `c` in [0, 1] (a body's Look::color).
+std_msgs::ColorRGBA rvizColor(const Eigen::Vector3d& c, float alpha = 1.0f)
 {
-  const double hue = std::fmod(static_cast<double>(body) * 137.508, 360.0) / 60.0;
-  const double x = 1.0 - std::abs(std::fmod(hue, 2.0) - 1.0);
-  const double rgb[6][3] = { { 1, x, 0 }, { x, 1, 0 }, { 0, 1, x }, { 0, x, 1 }, { x, 0, 1 }, { 1, 0, x } };
-  const auto& c = rgb[static_cast<int>(hue) % 6];
   std_msgs::ColorRGBA color;
-  color.r = static_cast<float>(0.2 + 0.8 * c[0]);
-  color.g = static_cast<float>(0.2 + 0.8 * c[1]);
-  color.b = static_cast<float>(0.2 + 0.8 * c[2]);
-  color.a = 1.0f;
+  color.r = static_cast<float>(c.x());
+  color.g = static_cast<float>(c.y());
+  color.b = static_cast<float>(c.z());
+  color.a = alpha;
   return color;
 }
 
@@ -46,13 +42,10 @@ visualization_msgs::Marker marker(const std::string& frame_id, const ros::Time& 
   return m;
 }
 
-/// A grey solid for the colliders, a little transparent so that a body behind one stays visible.
-std_msgs::ColorRGBA colliderColor()
+/// A collider's colour, a little transparent so that a body behind one stays visible.
+std_msgs::ColorRGBA colliderColor(const ColliderPose& collider)
 {
-  std_msgs::ColorRGBA color;
-  color.r = color.g = color.b = 0.6f;
-  color.a = 0.8f;
-  return color;
+  return rvizColor(collider.color, 0.8f);
 }
 
 /// Namespace "colliders": per collider k, id 3k its solid (SPHERE, CYLINDER, CUBE, or a MESH_RESOURCE of
@@ -72,11 +65,11 @@ void addColliderMarkers(const std::vector<ColliderPose>& poses, const std::strin
       type = visualization_msgs::Marker::CUBE;
     else if (c.shape == ColliderPose::Shape::Mesh)
       type = visualization_msgs::Marker::MESH_RESOURCE;
-    visualization_msgs::Marker solid = marker(frame_id, stamp, "colliders", id, type, 1.0, colliderColor());
+    visualization_msgs::Marker solid = marker(frame_id, stamp, "colliders", id, type, 1.0, colliderColor(c));
     if (c.shape == ColliderPose::Shape::Mesh)
     {
       solid.mesh_resource = c.mesh;
-      solid.mesh_use_embedded_materials = false;  // the colliders' grey, as the other shapes
+      solid.mesh_use_embedded_materials = false;  // its colour, as the other shapes
     }
     solid.pose = RosConverter::toPose(RigidPose{ c.position, c.orientation });
     solid.scale.x = c.size.x();
@@ -89,7 +82,7 @@ void addColliderMarkers(const std::vector<ColliderPose>& poses, const std::strin
     {
       const Vec3 axis = c.orientation * Vec3(0.0, 0.0, (end == 1 ? 0.5 : -0.5) * c.size.z());
       visualization_msgs::Marker cap = marker(frame_id, stamp, "colliders", id + end,
-                                              visualization_msgs::Marker::SPHERE, c.size.x(), colliderColor());
+                                              visualization_msgs::Marker::SPHERE, c.size.x(), colliderColor(c));
       cap.pose = RosConverter::toPose(RigidPose{ c.position + axis, c.orientation });
       array.markers.push_back(cap);
     }
@@ -124,9 +117,9 @@ void addRodMarkers(const Model& model, const State& state, const std::string& fr
     const std::size_t b = model.bodyOf(rod.first);
     const std::string& name = model.bodies[b].name;
     visualization_msgs::Marker strip = marker(frame_id, stamp, name, 2, visualization_msgs::Marker::LINE_STRIP,
-                                              2.0 * model.contact_radius[rod.first], bodyColor(b));
+                                              2.0 * model.contact_radius[rod.first], rvizColor(model.bodies[b].look.color));
     visualization_msgs::Marker axes =
-        marker(frame_id, stamp, name + "/frames", 0, visualization_msgs::Marker::LINE_LIST, 0.5 * kLineWidth, bodyColor(b));
+        marker(frame_id, stamp, name + "/frames", 0, visualization_msgs::Marker::LINE_LIST, 0.5 * kLineWidth, rvizColor(model.bodies[b].look.color));
     rodFrames(rod, x, state.twist, frames);
     const double length = 0.8 * rod.segment_length;
     for (int j = 0; j < rod.count; ++j)
@@ -176,7 +169,7 @@ void addVolumeMarkers(const Model& model, const NodeArray& x, const std::string&
     if (body.surface.empty())
       continue;
     visualization_msgs::Marker triangles =
-        marker(frame_id, stamp, body.name, 2, visualization_msgs::Marker::TRIANGLE_LIST, 1.0, bodyColor(b));
+        marker(frame_id, stamp, body.name, 2, visualization_msgs::Marker::TRIANGLE_LIST, 1.0, rvizColor(model.bodies[b].look.color));
     for (const std::array<int, 3>& t : body.surface)
       if (x.col(t[0]).allFinite() && x.col(t[1]).allFinite() && x.col(t[2]).allFinite())
         for (const int node : t)
@@ -205,7 +198,7 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const Model& model, cons
   for (std::size_t b = 0; b < model.bodies.size(); ++b)
   {
     const BodyRange& body = model.bodies[b];
-    const std_msgs::ColorRGBA color = bodyColor(b);
+    const std_msgs::ColorRGBA color = rvizColor(body.look.color);
     // A solid's nodes go in a namespace of their own, "<body>/nodes", which rviz can hide: its surface
     // (addVolumeMarkers) is the solid.
     const std::string nodes_namespace = body.surface.empty() ? body.name : body.name + "/nodes";
@@ -245,7 +238,7 @@ visualization_msgs::MarkerArray RosConverter::toMarkers(const Model& model, cons
     for (const std::vector<Vec3>& curve : controlled.controller->curves(state))
     {
       visualization_msgs::Marker strip = marker(frame_id, stamp, body.name, id++, visualization_msgs::Marker::LINE_STRIP,
-                                                2.0 * kLineWidth, bodyColor(static_cast<std::size_t>(controlled.body)));
+                                                2.0 * kLineWidth, rvizColor(body.look.color));
       for (const Vec3& p : curve)
         if (p.allFinite())
           strip.points.push_back(toPoint(p));
@@ -262,7 +255,7 @@ visualization_msgs::MarkerArray RosConverter::toForceMarkers(const std::vector<H
                                                              const std::string& frame_id, const ros::Time& stamp)
 {
   visualization_msgs::MarkerArray array;
-  // White: no body's hue (bodyColor), and brighter than the colliders' grey.
+  // White: no default body hue (defaultBodyColor), and brighter than the colliders' default grey.
   std_msgs::ColorRGBA white;
   white.r = white.g = white.b = white.a = 1.0f;
   array.markers.push_back(marker(frame_id, stamp, "forces", 0, visualization_msgs::Marker::ARROW, 1.0, white));

@@ -150,7 +150,10 @@ void SimNode::onTimer(const ros::TimerEvent&)
   const double elapsed = std::max(0.0, (now - last_tick_).toSec());
   last_tick_ = now;
   if (paused_)
+  {
     epoch_ += ros::Duration(elapsed);  // simulated time stands still while ROS time goes on
+    ++pauses_;
+  }
   else
   {
     noteHeldNodes();

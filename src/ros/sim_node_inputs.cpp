@@ -338,6 +338,8 @@ std::optional<RigidPose> SimNode::framePose(const std::string& frame, const ros:
       if (newest)
         *newest = transform.header.stamp;
     }
+    if (newest && stamp.isZero())
+      *newest = transform.header.stamp;  // the latest was asked for
   }
   catch (const tf2::TransformException& e)
   {
@@ -375,22 +377,33 @@ std::optional<Vec3> SimNode::frameOrigin(const std::string& frame, const ros::Ti
   return pose ? std::optional<Vec3>(pose->position) : std::nullopt;
 }
 
-std::optional<RigidPose> SimNode::followedPose(const std::string& frame, double t, InputGlide& glide)
+std::optional<RigidPose> SimNode::followedPose(const std::string& frame, double t, FrameGlide& follower)
 {
   std::optional<ros::Time> newest;
   const std::optional<RigidPose> pose = framePose(frame, rosTime(t), nullptr, &newest);
   if (!pose)
     return std::nullopt;
+  if (follower.pauses != pauses_)
+    follower = FrameGlide{ InputGlide(), pauses_ };
+  InputGlide& glide = follower.glide;
   // world_->time() is the step's start: a late frame's newest transform glides in from there.
-  glide.follow(world_->time(), t, pose->position, pose->orientation,
-               newest ? std::optional<double>((*newest - epoch_).toSec()) : std::nullopt, max_input_interval_);
+  const double start = world_->time();
+  std::optional<RigidPose> latest = pose;
+  if (!newest)
+  {
+    if (glide.onFrame(t, pose->position, pose->orientation))
+      return pose;
+    latest = framePose(frame, ros::Time(0), nullptr, &newest);  // off the frame: it glides on its transforms
+  }
+  if (latest && newest)
+    glide.followNewest(start, (*newest - epoch_).toSec(), latest->position, latest->orientation, max_input_interval_);
   return RigidPose{ glide.positionAt(t), *glide.orientationAt(t) };
 }
 
 void SimNode::followFrame(int anchor, const std::string& frame)
 {
   // The path is asked for the step's end: the frame's pose at that ROS time, interpolated by tf.
-  const auto glide = std::make_shared<InputGlide>();
+  const auto glide = std::make_shared<FrameGlide>(FrameGlide{ InputGlide(), pauses_ });
   world_->followPath(anchor, [this, frame, glide](double t) -> std::optional<Vec3> {
     const std::optional<RigidPose> pose = followedPose(frame, t, *glide);
     return pose ? std::optional<Vec3>(pose->position) : std::nullopt;
@@ -402,7 +415,7 @@ void SimNode::followFrame(const ColliderPlacement& collider)
   // The scene's pose of the collider is relative to its frame.
   const RigidPose local{ collider.position, collider.orientation };
   const std::string frame = collider.frame;
-  const auto glide = std::make_shared<InputGlide>();
+  const auto glide = std::make_shared<FrameGlide>(FrameGlide{ InputGlide(), pauses_ });
   world_->followColliderPath(collider.name, [this, frame, local, glide](double t) -> std::optional<RigidPose> {
     const std::optional<RigidPose> origin = followedPose(frame, t, *glide);
     if (!origin)
@@ -518,7 +531,7 @@ bool SimNode::onGrasp(Grasp::Request& request, Grasp::Response& response)
     return refuse(e.what());
   }
   const std::string frame = request.frame;
-  const auto glide = std::make_shared<InputGlide>();
+  const auto glide = std::make_shared<FrameGlide>(FrameGlide{ InputGlide(), pauses_ });
   world_->followGraspPath(frame, [this, frame, glide](double t) { return followedPose(frame, t, *glide); });
   const GraspedNodes& grasp = world_->grasps().back();
   const int first = world_->model().bodies[grasp.body].first;

@@ -44,6 +44,7 @@ Keys withCommonBodyKeys(const Keys& own)
 {
   Keys keys = { "name", "type" };
   keys.insert(keys.end(), own.begin(), own.end());
+  keys.push_back("color");
   keys.push_back("anchors");
   return keys;
 }

@@ -1,6 +1,7 @@
 #include "soft_body_sim/scene/scene_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <map>
 #include <optional>
@@ -20,13 +21,16 @@ namespace
 {
 using namespace scene_yaml;
 
-const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "colliders", "robot_colliders", "bodies" };
+const Keys kSceneKeys = { "frame_id", "rate", "physics", "planes", "colliders", "robot_colliders", "cameras", "bodies" };
+const Keys kCameraKeys = { "name",      "frame",     "position",  "orientation", "width",      "height", "horizontal_fov",
+                           "rate",      "min_range", "max_range", "background",  "noise" };
+const Keys kNoiseKeys = { "depth_stddev", "seed" };
 const Keys kPhysicsKeys = { "integrator", "dt", "substeps", "iterations", "gravity", "drag", "guard" };
 const Keys kGuardKeys = { "policy", "max_speed" };
-const Keys kPlaneKeys = { "name", "point", "normal", "restitution", "friction" };
+const Keys kPlaneKeys = { "name", "point", "normal", "restitution", "friction", "color" };
 const Keys kAnchorKeys = { "name", "node", "frame" };
 const Keys kPlacementKeys = { "name",     "shape",    "position",         "orientation", "velocity",
-                              "friction", "angular_velocity", "restitution", "frame" };
+                              "friction", "angular_velocity", "restitution", "frame", "color" };
 
 // --- scene parts -------------------------------------------------------------------------------
 
@@ -108,6 +112,7 @@ Plane readPlane(const Context& ctx, const Field& field)
   readOptional(ctx, field, "restitution", plane.restitution, readFraction);
   readOptional(ctx, field, "friction", plane.friction, readNonNegative);
   readOptional(ctx, field, "name", plane.name, readNonEmptyString);
+  readOptional(ctx, field, "color", plane.color, readColor);
   return plane;
 }
 
@@ -131,6 +136,7 @@ ColliderPlacement readPlacement(const Context& ctx, const Field& field)
   readOptional(ctx, field, "friction", at.friction, readNumber);
   readOptional(ctx, field, "restitution", at.restitution, readNumber);
   readOptional(ctx, field, "frame", at.frame, readFrameId);
+  readOptional(ctx, field, "color", at.color, readColor);
   if (!at.frame.empty())  // readFrameId takes no empty id
     for (const char* key : { "velocity", "angular_velocity" })
       if (const std::optional<Field> motion = optionalKey(field, key))
@@ -261,6 +267,55 @@ void readAnchors(const Context& ctx, const Field& field, BodyDef& body)
   }
 }
 
+/// One item of `cameras:`, checked by checkCamera (its error at the key it names).
+CameraDef readCamera(const Context& ctx, const Field& field)
+{
+  requireMap(ctx, field, kCameraKeys);
+  CameraDef camera;
+  const Field name = requiredKey(ctx, field, "name");
+  camera.name = readNonEmptyString(ctx, name);
+  // It names topics (~<name>/...) and tf frames (<name>_link): a ROS name's letters only.
+  const bool valid = std::isalpha(static_cast<unsigned char>(camera.name[0])) &&
+                     std::all_of(camera.name.begin(), camera.name.end(),
+                                 [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; });
+  if (!valid)
+    ctx.fail(name, "a camera's name starts with a letter and has only letters, digits and underscores (it names "
+                   "topics and tf frames); got " + quoted(camera.name));
+  readOptional(ctx, field, "frame", camera.frame, readFrameId);
+  readOptional(ctx, field, "position", camera.position, readVec3);
+  readOptional(ctx, field, "orientation", camera.orientation, readOrientation);
+  readOptional(ctx, field, "width", camera.width, readAtLeastOne);
+  readOptional(ctx, field, "height", camera.height, readAtLeastOne);
+  readOptional(ctx, field, "horizontal_fov", camera.horizontal_fov, readNumber);
+  readOptional(ctx, field, "rate", camera.rate, readPositive);
+  readOptional(ctx, field, "min_range", camera.min_range, readNonNegative);
+  readOptional(ctx, field, "max_range", camera.max_range, readPositive);
+  readOptional(ctx, field, "background", camera.background, readColor);
+  if (const std::optional<Field> noise = optionalKey(field, "noise"))
+  {
+    requireMap(ctx, *noise, kNoiseKeys);
+    DepthNoise read;
+    readOptional(ctx, *noise, "depth_stddev", read.depth_stddev, readNonNegative);
+    if (const std::optional<Field> seed = optionalKey(*noise, "seed"))
+    {
+      const long long value = readInteger(ctx, *seed);
+      if (value < 0)
+        ctx.fail(*seed, "seed must be an integer >= 0");
+      read.seed = static_cast<std::uint64_t>(value);
+    }
+    camera.noise = read;
+  }
+  try
+  {
+    checkCamera(camera);
+  }
+  catch (const DefinitionError& e)
+  {
+    failAtKeys(ctx, field, e);
+  }
+  return camera;
+}
+
 BodyDef readBody(const Context& ctx, const Field& field, const SceneSoFar& scene)
 {
   requireMapping(ctx, field);
@@ -273,6 +328,8 @@ BodyDef readBody(const Context& ctx, const Field& field, const SceneSoFar& scene
     if (name == body_type.name)
     {
       BodyDef body = body_type.read(ctx, field, scene);
+      if (const std::optional<Field> color = optionalKey(field, "color"))
+        body.color = readColor(ctx, *color);
       if (const std::optional<Field> anchors = optionalKey(field, "anchors"))
         readAnchors(ctx, *anchors, body);
       return body;
@@ -315,6 +372,14 @@ SceneDef readScene(const Context& ctx, const Field& root, const SceneLimits& lim
     }
 
   readOptional(ctx, root, "robot_colliders", scene.robot_colliders, readRobotColliders);
+  if (const std::optional<Field> cameras = optionalKey(root, "cameras"))
+    for (const Field& item : requireList(ctx, *cameras))
+    {
+      scene.cameras.push_back(readCamera(ctx, item));
+      for (std::size_t k = 0; k + 1 < scene.cameras.size(); ++k)
+        if (scene.cameras[k].name == scene.cameras.back().name)
+          ctx.fail(requiredKey(ctx, item, "name"), "duplicate camera name " + quoted(scene.cameras.back().name));
+    }
 
   const Field bodies = requiredKey(ctx, root, "bodies");
   std::map<std::string, std::string> path_by_name;  // to name the first body in a duplicate error

@@ -375,6 +375,14 @@ Vec3 readVec3(const Context& ctx, const Field& field)
   return Vec3(readNumber(ctx, items[0]), readNumber(ctx, items[1]), readNumber(ctx, items[2]));
 }
 
+Vec3 readColor(const Context& ctx, const Field& field)
+{
+  const Vec3 color = readVec3(ctx, field);
+  if (!((color.array() >= 0.0).all() && (color.array() <= 1.0).all()))
+    ctx.fail(field, "a color is [r, g, b], each from 0 to 1");
+  return color;
+}
+
 int readNodeIndex(const Context& ctx, const Field& field, std::size_t node_count)
 {
   const long long index = readInteger(ctx, field);

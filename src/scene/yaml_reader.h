@@ -104,6 +104,8 @@ bool readBool(const Context& ctx, const Field& field);
 std::string readNonEmptyString(const Context& ctx, const Field& field);
 /// A list of exactly 3 finite numbers.
 Vec3 readVec3(const Context& ctx, const Field& field);
+/// [r, g, b], each in [0, 1].
+Vec3 readColor(const Context& ctx, const Field& field);
 /// An index into a body of `node_count` nodes.
 int readNodeIndex(const Context& ctx, const Field& field, std::size_t node_count);
 

@@ -2,15 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
+#include "soft_body_sim/core/sensing/depth_camera.h"
 #include "soft_body_sim/core/stability.h"
 #include "soft_body_sim/scene/scene_loader.h"
+#include "soft_body_sim/tools/camera_images.h"
 
 namespace soft_body_sim
 {
@@ -24,7 +28,7 @@ struct UsageError : std::runtime_error
 
 const char* const kUsage =
     "usage: simulate --scene FILE [--duration S] [--integrator NAME] [--dt S] [--substeps N] "
-    "[--iterations N] [--every K] [--csv FILE] [--forces FILE] [--tensions FILE]";
+    "[--iterations N] [--every K] [--csv FILE] [--forces FILE] [--tensions FILE] [--images DIR]";
 
 struct Options
 {
@@ -39,6 +43,7 @@ struct Options
   std::optional<std::string> csv;
   std::optional<std::string> forces;    ///< anchors' and colliders' wrenches
   std::optional<std::string> tensions;  ///< links' tensions
+  std::optional<std::string> images;    ///< a directory for the cameras' frames
 };
 
 double parseNumber(const std::string& option, const std::string& text)
@@ -84,7 +89,7 @@ Options parseOptions(const std::vector<std::string>& args)
     const std::string& option = args[k];
     static const char* const kKnown[] = { "--scene", "--duration", "--integrator", "--dt",
                                           "--substeps", "--iterations", "--every", "--csv",
-                                          "--forces", "--tensions" };
+                                          "--forces", "--tensions", "--images" };
     if (std::find(std::begin(kKnown), std::end(kKnown), option) == std::end(kKnown))
       throw UsageError("unknown option '" + option + "'; " + kUsage);
     if (k + 1 >= args.size())
@@ -126,6 +131,12 @@ Options parseOptions(const std::vector<std::string>& args)
     options.forces = values["--forces"];
   if (values.count("--tensions"))
     options.tensions = values["--tensions"];
+  if (values.count("--images"))
+  {
+    options.images = values["--images"];
+    if (!std::filesystem::is_directory(*options.images))
+      throw UsageError("--images: no directory '" + *options.images + "'");
+  }
   return options;
 }
 
@@ -210,6 +221,40 @@ void writeTensions(std::ostream& csv, const World& world)
 }
 
 /// An output file named by `option`, or none.
+/// The scene's cameras that take pictures without ROS, each with its next frame number: one on a tf frame
+/// does not (noted on `err`), as a collider on one never appears.
+struct Photographer
+{
+  const CameraDef* def = nullptr;
+  std::unique_ptr<DepthCamera> camera;
+  std::uint64_t frame = 0;
+
+  /// Writes every frame due by the world's time: frame n at n / rate.
+  void shoot(const World& world, const std::string& directory)
+  {
+    while (static_cast<double>(frame) / def->rate <= world.time() + 1e-9 / def->rate)
+    {
+      const RigidPose link{ def->position, def->orientation.normalized() };
+      writeCameraImages(directory, def->name, frame, camera->render(world.state(), world.colliderPoses(), link, frame));
+      ++frame;
+    }
+  }
+};
+
+std::vector<Photographer> photographers(const SceneDef& scene, const World& world, std::ostream& err)
+{
+  if (scene.cameras.empty())
+    throw UsageError("--images: the scene declares no cameras");
+  std::vector<Photographer> all;
+  for (const CameraDef& camera : scene.cameras)
+    if (camera.frame.empty())
+      all.push_back({ &camera, std::make_unique<DepthCamera>(camera, world.model()), 0 });
+    else
+      err << "simulate: note: camera '" << camera.name << "' rides on tf frame '" << camera.frame
+          << "': without tf it takes no pictures\n";
+  return all;
+}
+
 std::optional<std::ofstream> openOutput(const std::string& option, const std::optional<std::string>& path)
 {
   if (!path)
@@ -231,6 +276,7 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
   std::optional<std::ofstream> file = openOutput("--csv", options.csv);
   std::optional<std::ofstream> forces = openOutput("--forces", options.forces);
   std::optional<std::ofstream> tensions = openOutput("--tensions", options.tensions);
+  std::vector<Photographer> cameras = options.images ? photographers(scene, world, err) : std::vector<Photographer>();
   if (scene.physics.auto_dt)
     err << "simulate: note: dt auto chose dt = " << world.settings().dt << " s in " << world.settings().substeps
         << " sub-step(s) for " << integratorName(world.integrator()) << '\n';
@@ -251,7 +297,12 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
     if (tensions)
       writeTensions(*tensions, world);
   };
+  const auto shoot = [&] {
+    for (Photographer& camera : cameras)
+      camera.shoot(world, *options.images);
+  };
   record();
+  shoot();
   for (long long n = 1; n <= steps; ++n)
   {
     world.step();
@@ -259,6 +310,7 @@ void simulate(const Options& options, std::ostream& out, std::ostream& err)
       err << "simulate: warning: " << event.describe() << '\n';
     if (n == steps || (options.every && n % *options.every == 0))
       record();
+    shoot();
   }
   csv.flush();
   if (!csv || (forces && !forces->flush()) || (tensions && !tensions->flush()))

@@ -114,6 +114,27 @@ struct Tetrahedron
   double pressure = 0.0;     ///< p0 [Pa] of the gas it holds (tetrahedra.h), >= 0; 0: no gas
 };
 
+/// [m] The radius a body without a contact radius is seen with (a camera; rviz draws its nodes as balls of
+/// this radius too).
+constexpr double kDefaultLookRadius = 0.01;
+
+/// How a body looks to a camera (sensing/depth_camera.h): round tubes between node pairs and triangles
+/// between nodes, in its colour; a node in neither is a ball. buildWorld derives it: a body type's faces
+/// (a cloth's or jelly's grid, BodyDef::faces; a solid's surface), else its contact segments (a rope's,
+/// a rod's links), else its springs and constraints.
+struct Look
+{
+  std::vector<std::pair<int, int>> tubes;  ///< global node index pairs
+  std::vector<std::array<int, 3>> faces;   ///< global node indices, seen from both sides
+  std::vector<int> balls;                  ///< nodes in no tube or face
+  double radius = kDefaultLookRadius;      ///< [m] of its tubes and balls: its contact radius if it has one
+  Eigen::Vector3d color = Eigen::Vector3d::Constant(0.6);  ///< rgb in [0, 1]
+};
+
+/// The colour of body `body` (its index in the scene) when the scene gives none: golden-angle hues, distinct
+/// and stable, as rviz has always shown them.
+Eigen::Vector3d defaultBodyColor(std::size_t body);
+
 /// A named run of consecutive nodes: the scene's bodies share one node array.
 struct BodyRange
 {
@@ -131,6 +152,7 @@ struct BodyRange
   /// A solid's Coulomb coefficient [-] against the other bodies' nodes on its surface (surface_contacts.h;
   /// two solids use the mean of theirs); 0 for every other body.
   double surface_friction = 0.0;
+  Look look;  ///< how a camera and rviz see it
 };
 
 /// A point of a solid's boundary triangle, at fixed barycentric weights of its three nodes (summing to 1),

@@ -13,6 +13,7 @@
 #include "soft_body_sim/core/guard.h"
 #include "soft_body_sim/core/integrators/integrator.h"
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/sensing/camera_def.h"
 #include "soft_body_sim/core/world.h"
 
 namespace soft_body_sim
@@ -110,6 +111,11 @@ struct BodyDef
   double surface_friction = 0.0;
   /// Model::surface_samples, in the body's node indices (a volume's surface_samples); empty: none.
   std::vector<SurfaceSample> surface_samples;
+  /// Triangles of node indices within the body that a camera sees (a cloth's or a jelly's grid, two per
+  /// square); empty: it is seen by its surface, its contact segments or its links (Look).
+  std::vector<std::array<int, 3>> faces;
+  /// rgb in [0, 1] (`color`); none: defaultBodyColor.
+  std::optional<Vec3> color;
 };
 
 /// The checks of a body's self-contact keys, for the builder of its type (rope, rod, cloth, jelly) or, for a
@@ -146,6 +152,7 @@ struct SceneDef
   PhysicsDef physics;
   Colliders colliders;  ///< what every body collides with (colliders.h)
   std::optional<RobotCollidersDef> robot_colliders;  ///< more colliders from a URDF (ROS node only)
+  std::vector<CameraDef> cameras;  ///< simulated RGB-D cameras (sensing/depth_camera.h); usually none
   std::vector<BodyDef> bodies;
 };
 

@@ -17,11 +17,12 @@
 //   (one far behind its stream catches up faster), and an input that only turns takes its interval.
 // - A late input (stamped before the step it reaches) starts its glide at its stamp, as if on time: the
 //   step it reaches puts the anchor where the glide is by then.
-// - A tf frame is its own stream (`follow`): where tf has transforms on both sides of a step's end (the
-//   frame is published ahead), tf's interpolation there is exact and smooth; past the frame's newest
-//   transform (late), each newer one glides in from the step that first sees it, rather than being
-//   reached in that step, and the holder stays a glide until it rests on tf's pose. When a late
-//   transform is seen depends on when it came: a replay is exact only for frames published ahead.
+// - A tf frame is its own stream (onFrame, followNewest): where tf has transforms on both sides of a step's
+//   end (the frame is published ahead), tf's interpolation there is exact and smooth; past the frame's
+//   newest transform (late), each newer transform glides in from the step that first sees it, rather than
+//   being reached in that step, and the holder glides on the frame's transforms until it rests on tf's
+//   pose. When a late transform is seen depends on when it came: a replay is exact only for frames
+//   published ahead.
 // - A target after a pause longer than `max_interval` starts afresh, at once (`addAfterPauseAtOnce`).
 // Plain data: unit-testable without a master.
 #pragma once
@@ -39,37 +40,7 @@ public:
   /// An input stamped `t` [s of simulated time] toward `position` [m] and, if given, `orientation`.
   void add(double t, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation, double max_interval)
   {
-    addSeenAt(t, t, position, orientation, max_interval);
-  }
-
-  /// An input stamped `stamp` but seen only at `start` [s], after its stamp (a tf frame's newest
-  /// transform, when the frame is published late): it glides from where the glide is at `start`, at the
-  /// stream's speed, so it arrives about one interval after `start`. Not for replays: when a late
-  /// input is seen depends on when it came.
-  void addSeenAt(double stamp, double start, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation,
-                 double max_interval)
-  {
-    const double interval = started_ ? std::min(stamp - last_stamp_, max_interval) : 0.0;
-    double duration = 0.0;
-    if (interval > 0.0)
-    {
-      from_ = positionAt(start);
-      from_orientation_ = orientation && to_orientation_ ? orientationAt(start) : orientation;
-      const double speed = (position - to_).norm() / interval;  // the stream's, from the previous input
-      const double distance = (position - from_).norm();
-      duration = speed > 0.0 ? std::min(distance / speed, max_interval) : interval;
-    }
-    else
-    {
-      from_ = position;
-      from_orientation_ = orientation;
-    }
-    to_ = position;
-    to_orientation_ = orientation;
-    from_time_ = start;
-    to_time_ = start + duration;
-    last_stamp_ = stamp;
-    started_ = true;
+    glide(t, t, position, orientation, max_interval, 1.0);
   }
 
   /// The pose is known exactly at time t (a tf frame's transform interpolated there): it is there, at
@@ -82,31 +53,30 @@ public:
     started_ = true;
   }
 
-  /// One step, from `start` to `end` [s], of a holder on a tf frame, given the frame's pose from tf: its pose
-  /// at `end` where `newest` is nullopt (tf had transforms on both sides of `end`), else its newest
-  /// transform, stamped `newest` (the frame is late). positionAt(end) and orientationAt(end) are then the
-  /// holder's: where the newest transform glides in from the step that first saw it, or tf's exact pose.
-  /// Once it has glided, tf's poses glide in too, each stamped its step's end, until the holder comes to
-  /// rest on tf's pose (the frame stopped): a frame stamped about when its steps end is late for one step
-  /// and not for the next, and a holder put on tf's pose there would jump the interval it is behind.
-  void follow(double start, double end, const Vec3& position, const Eigen::Quaterniond& orientation,
-              const std::optional<double>& newest, double max_interval)
+  /// A holder on a tf frame, in a step ending at `end` [s] where tf has the frame on both sides (published
+  /// ahead): it takes tf's pose there if it is on the frame (it was in the last step, it has not started,
+  /// or its glide ended right there, the frame at rest), and says so. Otherwise it keeps gliding
+  /// (followNewest): a frame stamped about when its steps end is late for one step and not for the next,
+  /// and a holder put back on tf's pose would jump the interval it is behind.
+  bool onFrame(double end, const Vec3& position, const Eigen::Quaterniond& orientation)
   {
-    if (newest)
-    {
-      if (!started_ || *newest > last_stamp_)
-        addSeenAt(*newest, start, position, orientation, max_interval);
-      on_frame_ = false;
-      return;
-    }
-    const bool same = to_ == position && to_orientation_ && to_orientation_->coeffs() == orientation.coeffs();
-    if (!started_ || on_frame_ || (same && !movingAfter(start)))
+    if (!started_ || on_frame_ || (!movingAfter(end) && isLastInput(position, orientation)))
     {
       place(end, position, orientation);
       on_frame_ = true;
     }
-    else if (!same)  // a frame at rest adds nothing: the glide ends on it at the speed it had
-      addSeenAt(end, start, position, orientation, max_interval);
+    return on_frame_;
+  }
+
+  /// A holder on a tf frame, in a step from `start` [s] that ends past the frame's newest transform (the
+  /// frame is late) or in which it is off the frame: a newest transform newer than the last glides in from
+  /// `start`, at the frame's speed, faster (kFrameCatchUp) while the holder is more than an interval behind.
+  void followNewest(double start, double stamp, const Vec3& position, const Eigen::Quaterniond& orientation,
+                    double max_interval)
+  {
+    on_frame_ = false;
+    if (!started_ || (stamp > last_stamp_ && !isLastInput(position, orientation)))
+      glide(stamp, start, position, orientation, max_interval, kFrameCatchUp);
   }
 
   /// As add, except that an input after a pause longer than `max_interval` starts a new stream, reached
@@ -137,6 +107,51 @@ public:
   bool movingAfter(double t) const { return started_ && t < to_time_; }
 
 private:
+  bool isLastInput(const Vec3& position, const Eigen::Quaterniond& orientation) const
+  {
+    return to_ == position && to_orientation_ && to_orientation_->coeffs() == orientation.coeffs();
+  }
+
+  /// How much faster than its frame a holder may glide while it is more than one interval behind: a lag
+  /// (a tick that saw a transform late, dropped time, a frame that jumped) shrinks instead of lasting
+  /// as long as the frame moves, and the holder never runs at more than this times the frame's speed.
+  static constexpr double kFrameCatchUp = 1.25;
+
+  /// An input stamped `stamp`, taken from `start` [s] (its stamp, or after it: a tf frame's transform seen
+  /// in a later step), from where the glide is then, at the stream's speed (the distance from the
+  /// previous input over the time between their stamps); while it would take longer than that interval,
+  /// at up to `catch_up` times that speed. A late input's start depends on when it came: not for replays.
+  void glide(double stamp, double start, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation,
+             double max_interval, double catch_up)
+  {
+    const double interval = started_ ? std::min(stamp - last_stamp_, max_interval) : 0.0;
+    double duration = 0.0;
+    if (interval > 0.0)
+    {
+      from_ = positionAt(start);
+      from_orientation_ = orientation && to_orientation_ ? orientationAt(start) : orientation;
+      const double speed = (position - to_).norm() / interval;  // the stream's, from the previous input
+      const double distance = (position - from_).norm();
+      const double at_speed = distance / speed;
+      // An input that only turns takes its interval, or what is left of the glide under way if longer (a
+      // late transform seen just after the pose tf gave for the step before: no jump for it).
+      duration = speed > 0.0 ? std::min(at_speed <= interval ? at_speed : std::max(interval, at_speed / catch_up),
+                                        max_interval) :
+                               std::max(interval, to_time_ - start);
+    }
+    else
+    {
+      from_ = position;
+      from_orientation_ = orientation;
+    }
+    to_ = position;
+    to_orientation_ = orientation;
+    from_time_ = start;
+    to_time_ = start + duration;
+    last_stamp_ = stamp;
+    started_ = true;
+  }
+
   /// How far along the glide is at time t, from 0 to 1.
   double share(double t) const
   {
@@ -144,7 +159,7 @@ private:
   }
 
   bool started_ = false;
-  bool on_frame_ = false;  ///< follow: placed on tf's exact pose in the last step
+  bool on_frame_ = false;  ///< onFrame: on tf's exact pose in the last step
   double last_stamp_ = 0.0;  ///< [s] of the last input
   double from_time_ = 0.0, to_time_ = 0.0;  ///< [s]
   Vec3 from_ = Vec3::Zero(), to_ = Vec3::Zero();  ///< [m]

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
@@ -91,13 +92,21 @@ private:
   /// The pose of tf frame `frame` in the scene frame at ROS time `stamp` (the latest transform if tf has
   /// none that recent yet); nullopt with a throttled warning if tf has none at all, or one that is not
   /// finite or beyond ~workspace_radius; `why`, if given, is set to the reason; `newest`, if given, to the
-  /// latest transform's stamp when that was used (the frame is late), to nullopt when tf interpolated.
+  /// latest transform's stamp when that was used (the frame is late, or `stamp` is 0), to nullopt when tf
+  /// interpolated.
   std::optional<RigidPose> framePose(const std::string& frame, const ros::Time& stamp, std::string* why = nullptr,
                                      std::optional<ros::Time>* newest = nullptr);
+  /// A holder's or collider's glide along the tf frame it follows, and the pause count it glides in.
+  struct FrameGlide
+  {
+    InputGlide glide;
+    std::uint64_t pauses = 0;
+  };
   /// The pose of a holder or collider following `frame` at the end of the step that ends at simulated
-  /// time t [s]: tf's where it has transforms on both sides of t, else where `glide` has the newest
-  /// transform gliding in since the step that first saw it (input_glide.h; ~max_input_interval).
-  std::optional<RigidPose> followedPose(const std::string& frame, double t, InputGlide& glide);
+  /// time t [s]: tf's where it has transforms on both sides of t, else where `follower`'s glide has the
+  /// newest transform gliding in since the step that first saw it (input_glide.h; ~max_input_interval).
+  /// After a pause it starts afresh: the frame moved while the simulation stood, and it goes there at once.
+  std::optional<RigidPose> followedPose(const std::string& frame, double t, FrameGlide& follower);
   /// framePose's position.
   std::optional<Vec3> frameOrigin(const std::string& frame, const ros::Time& stamp, std::string* why = nullptr);
   /// Makes anchor `anchor` follow tf frame `frame` every step.
@@ -181,6 +190,7 @@ private:
   double max_input_interval_ = 0.5;
   std::map<int, InputGlide> glides_;  ///< per anchor index, once it has had an input
   std::map<std::string, InputGlide> target_glides_;  ///< per body, once it has had a target
+  std::uint64_t pauses_ = 0;  ///< ticks spent paused since the start: a frame's glide restarts after one
   std::vector<std::string> handle_names_;  ///< per scene anchor: its handle ("" = follows a frame)
   std::vector<std::pair<std::string, std::string>> target_handles_;  ///< (body, handle) per target
   std::map<std::string, Vec3> targets_;  ///< last target set per body [m]

@@ -50,15 +50,17 @@ void requireSprings(const std::string& what, const std::string& key, const Sprin
   requireDefinition(springs.damping >= 0.0, what, { key + ".damping", key }, key + ".damping must be >= 0");
 }
 
-void addGridTriangles(BodyDef& body, int columns, int rows)
+void addGridTriangles(BodyDef& body, int columns, int rows, bool face_contacts)
 {
   const auto node = [columns](int i, int j) { return j * columns + i; };
   for (int j = 0; j + 1 < rows; ++j)
     for (int i = 0; i + 1 < columns; ++i)
     {
-      body.contact_triangles.push_back({ node(i, j), node(i + 1, j), node(i + 1, j + 1) });
-      body.contact_triangles.push_back({ node(i, j), node(i + 1, j + 1), node(i, j + 1) });
+      body.faces.push_back({ node(i, j), node(i + 1, j), node(i + 1, j + 1) });
+      body.faces.push_back({ node(i, j), node(i + 1, j + 1), node(i, j + 1) });
     }
+  if (face_contacts)
+    body.contact_triangles = body.faces;
 }
 
 void addSpringGrid(BodyDef& body, const GridCorners& corners, int columns, int rows, double mass,
@@ -130,8 +132,7 @@ BodyDef buildCloth(const std::string& name, const ClothDef& cloth)
   for (int index : cloth.pinned)
     body.nodes[static_cast<std::size_t>(resolveNodeIndex(index, nx * ny))].pinned = true;
   const auto node = [nx](int i, int j) { return j * nx + i; };
-  if (cloth.face_contacts)
-    addGridTriangles(body, nx, ny);
+  addGridTriangles(body, nx, ny, cloth.face_contacts);
   if (cloth.bending)
     for (int j = 0; j < ny; ++j)
       for (int i = 0; i < nx; ++i)

@@ -56,8 +56,7 @@ BodyDef buildJelly(const std::string& name, const JellyDef& jelly)
       cell.pressure = jelly.pressure;  // rest area: the initial one
       body.cells.push_back(cell);
     }
-  if (jelly.face_contacts)
-    addGridTriangles(body, columns, jelly.ny + 1);
+  addGridTriangles(body, columns, jelly.ny + 1, jelly.face_contacts);
   return body;
 }
 

@@ -83,10 +83,11 @@ void requireSprings(const std::string& what, const std::string& key, const Sprin
 
 void addSpringGrid(BodyDef& body, const GridCorners& corners, int columns, int rows, double mass,
                    const SpringParameters& edges, const SpringParameters& diagonals);
-/// Appends to `body` the contact triangles of a grid of columns x rows nodes that addSpringGrid laid as its
-/// first nodes (node (i, j) = j columns + i): two per square, split along the diagonal from (i, j) to
-/// (i + 1, j + 1), row by row (face_contacts.h). The cloth's and the jelly's `face_contacts`.
-void addGridTriangles(BodyDef& body, int columns, int rows);
+/// Sets the faces (Look) of a grid of columns x rows nodes that addSpringGrid laid as `body`'s first nodes
+/// (node (i, j) = j columns + i): two per square, split along the diagonal from (i, j) to (i + 1, j + 1),
+/// row by row; with `face_contacts` they are its contact triangles too (face_contacts.h). The cloth's and
+/// the jelly's.
+void addGridTriangles(BodyDef& body, int columns, int rows, bool face_contacts);
 
 /// The cloth as nodes and springs (type "cloth"), every spring at rest in the flat initial layout;
 /// throws std::invalid_argument on a bad definition and std::out_of_range on a bad pinned index.

@@ -22,6 +22,7 @@ struct Plane
   double restitution = 0.0;                           ///< normal speed kept after a bounce, in [0, 1]
   double friction = 0.0;                              ///< Coulomb coefficient [-], >= 0
   std::string name{};  ///< names its wrench (World::colliderWrenches, about `point`); empty: none reported
+  Eigen::Vector3d color = Eigen::Vector3d::Constant(0.8);  ///< rgb in [0, 1], as a camera sees it
 };
 
 /// Where a rigid collider is and how it moves, and its surface. Its pose moves at constant `velocity`
@@ -37,6 +38,7 @@ struct ColliderPlacement
   double friction = 0.0;     ///< Coulomb coefficient [-], >= 0
   double restitution = 0.0;  ///< normal speed kept after a bounce, in [0, 1]
   std::string frame;         ///< a tf frame the ROS node makes it follow (pose relative to it); empty = none
+  Eigen::Vector3d color = Eigen::Vector3d::Constant(0.6);  ///< rgb in [0, 1], as rviz and a camera see it
 };
 
 /// A ball of `radius` [m] about its origin.

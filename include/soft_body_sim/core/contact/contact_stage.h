@@ -38,18 +38,30 @@ struct ColliderPose
   /// mesh: its scale [-] (the file's coordinates are metres).
   Vec3 size = Vec3::Zero();
   std::string mesh;  ///< a mesh's file as rviz loads it (Mesh::uri: package:// or file://); else empty
+  Vec3 color = Vec3::Constant(0.6);  ///< rgb in [0, 1] (ColliderPlacement::color)
 
-  static ColliderPose of(const Sphere& s) { return { s.at.name, Shape::Sphere, s.at.position, s.at.orientation, Vec3::Constant(2.0 * s.radius), {} }; }
+  static ColliderPose of(const Sphere& s)
+  {
+    return { s.at.name, Shape::Sphere, s.at.position, s.at.orientation, Vec3::Constant(2.0 * s.radius), {}, s.at.color };
+  }
   static ColliderPose of(const Capsule& c)
   {
-    return { c.at.name, Shape::Capsule, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {} };
+    return { c.at.name, Shape::Capsule, c.at.position, c.at.orientation,
+             Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {}, c.at.color };
   }
-  static ColliderPose of(const Box& b) { return { b.at.name, Shape::Box, b.at.position, b.at.orientation, b.size, {} }; }
+  static ColliderPose of(const Box& b)
+  {
+    return { b.at.name, Shape::Box, b.at.position, b.at.orientation, b.size, {}, b.at.color };
+  }
   static ColliderPose of(const Cylinder& c)
   {
-    return { c.at.name, Shape::Cylinder, c.at.position, c.at.orientation, Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {} };
+    return { c.at.name, Shape::Cylinder, c.at.position, c.at.orientation,
+             Vec3(2.0 * c.radius, 2.0 * c.radius, c.length), {}, c.at.color };
   }
-  static ColliderPose of(const Mesh& m) { return { m.at.name, Shape::Mesh, m.at.position, m.at.orientation, m.scale, m.uri }; }
+  static ColliderPose of(const Mesh& m)
+  {
+    return { m.at.name, Shape::Mesh, m.at.position, m.at.orientation, m.scale, m.uri, m.at.color };
+  }
 };
 
 /// A rigid pose: position [m] and orientation (unit quaternion) of a collider's origin and axes.

@@ -1,0 +1,443 @@
+// DepthCamera: Embree 3 geometry for the scene's looks, colliders and planes, refitted per frame, and one
+// ray per pixel (depth_camera.h).
+#include "soft_body_sim/core/sensing/depth_camera.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include <embree3/rtcore.h>
+
+#include "soft_body_sim/core/contact/mesh_field.h"
+
+namespace soft_body_sim
+{
+namespace
+{
+/// How far planes reach from the point below the camera, in units of its max_range: far enough that a
+/// floor fills the picture up to its horizon's last few pixels.
+constexpr double kPlaneReach = 10.0;
+
+/// The twelve triangles of a box's eight corners (corner k at the signs of bits 0, 1, 2 along x, y, z),
+/// counter-clockwise seen from outside.
+constexpr unsigned kBoxTriangles[12][3] = { { 0, 2, 3 }, { 0, 3, 1 }, { 4, 5, 7 }, { 4, 7, 6 }, { 0, 1, 5 }, { 0, 5, 4 },
+                                            { 2, 6, 7 }, { 2, 7, 3 }, { 0, 4, 6 }, { 0, 6, 2 }, { 1, 3, 7 }, { 1, 7, 5 } };
+
+/// Who a geometry belongs to: its mask value and its colour.
+struct Owner
+{
+  std::uint16_t mask = 0;
+  Eigen::Vector3d color = Eigen::Vector3d::Zero();
+};
+
+Eigen::Vector3f relative(const Vec3& point, const Vec3& eye) { return (point - eye).cast<float>(); }
+
+/// Writes a point into a vertex buffer's three floats at `at`.
+void put(float* at, const Eigen::Vector3f& point)
+{
+  at[0] = point.x();
+  at[1] = point.y();
+  at[2] = point.z();
+}
+
+}  // namespace
+
+struct DepthCamera::Scene
+{
+  /// A body's geometries (Look): its faces, tubes and balls, each absent (RTC_INVALID_GEOMETRY_ID) if empty.
+  struct Body
+  {
+    const Look* look = nullptr;
+    int first = 0, count = 0;
+    unsigned faces = RTC_INVALID_GEOMETRY_ID, tubes = RTC_INVALID_GEOMETRY_ID, balls = RTC_INVALID_GEOMETRY_ID;
+  };
+  /// A shape collider's geometry, by its name.
+  struct Collider
+  {
+    std::string name;
+    ColliderPose::Shape shape = ColliderPose::Shape::Sphere;
+    double radius = 0.0, length = 0.0;  ///< [m] sphere, capsule, cylinder
+    Vec3 size = Vec3::Zero();           ///< [m] box
+    std::shared_ptr<const TriangleMesh> mesh;
+    unsigned geometry = RTC_INVALID_GEOMETRY_ID;
+    bool enabled = true;
+  };
+  struct PlaneGeometry
+  {
+    Plane plane;
+    unsigned geometry = RTC_INVALID_GEOMETRY_ID;
+  };
+
+  CameraDef def;
+  CameraIntrinsics intrinsics;
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::vector<Owner> owners;  ///< by geometry id
+  std::vector<Body> bodies;
+  std::vector<Collider> colliders;
+  std::vector<PlaneGeometry> planes;
+
+  Scene(const CameraDef& camera, const Model& model);
+  ~Scene()
+  {
+    if (scene)
+      rtcReleaseScene(scene);
+    if (device)
+      rtcReleaseDevice(device);
+  }
+
+  /// A new geometry of `type` attached to the scene for `owner`, refitted rather than rebuilt; its id.
+  unsigned add(RTCGeometryType type, const Owner& owner, std::size_t vertices, RTCFormat vertex_format,
+               std::size_t vertex_size, std::size_t primitives, RTCFormat index_format, std::size_t index_size)
+  {
+    RTCGeometry geometry = rtcNewGeometry(device, type);
+    rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, vertex_format, vertex_size, vertices);
+    if (primitives > 0)
+      rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, index_format, index_size, primitives);
+    rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
+    const unsigned id = rtcAttachGeometry(scene, geometry);
+    rtcReleaseGeometry(geometry);
+    if (owners.size() <= id)
+      owners.resize(id + 1);
+    owners[id] = owner;
+    return id;
+  }
+  unsigned addTriangles(const Owner& owner, std::size_t vertices, const std::vector<std::array<unsigned, 3>>& triangles)
+  {
+    const unsigned id = add(RTC_GEOMETRY_TYPE_TRIANGLE, owner, vertices, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                            triangles.size(), RTC_FORMAT_UINT3, 3 * sizeof(unsigned));
+    auto* index = static_cast<unsigned*>(rtcGetGeometryBufferData(rtcGetGeometry(scene, id), RTC_BUFFER_TYPE_INDEX, 0));
+    for (const std::array<unsigned, 3>& t : triangles)
+      for (const unsigned corner : t)
+        *index++ = corner;
+    return id;
+  }
+  /// Linear curves (round: tubes with round ends; cone: capped cylinders) of one segment per pair of vertices.
+  unsigned addSegments(RTCGeometryType type, const Owner& owner, std::size_t segments)
+  {
+    const unsigned id = add(type, owner, 2 * segments, RTC_FORMAT_FLOAT4, 4 * sizeof(float), segments,
+                            RTC_FORMAT_UINT, sizeof(unsigned));
+    auto* index = static_cast<unsigned*>(rtcGetGeometryBufferData(rtcGetGeometry(scene, id), RTC_BUFFER_TYPE_INDEX, 0));
+    for (std::size_t k = 0; k < segments; ++k)
+      index[k] = static_cast<unsigned>(2 * k);
+    return id;
+  }
+  unsigned addPoints(const Owner& owner, std::size_t points)
+  {
+    return add(RTC_GEOMETRY_TYPE_SPHERE_POINT, owner, points, RTC_FORMAT_FLOAT4, 4 * sizeof(float), 0,
+               RTC_FORMAT_UNDEFINED, 0);
+  }
+
+  float* vertices(unsigned id) const
+  {
+    return static_cast<float*>(rtcGetGeometryBufferData(rtcGetGeometry(scene, id), RTC_BUFFER_TYPE_VERTEX, 0));
+  }
+  void commit(unsigned id) const
+  {
+    RTCGeometry geometry = rtcGetGeometry(scene, id);
+    rtcUpdateGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0);
+    rtcCommitGeometry(geometry);
+  }
+
+  void placeBodies(const State& state, const Vec3& eye) const;
+  void placeColliders(const std::vector<ColliderPose>& poses, const Vec3& eye);
+  void placePlanes(const Vec3& eye) const;
+};
+
+DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
+  : def(camera), intrinsics(CameraIntrinsics::of(camera))
+{
+  device = rtcNewDevice(nullptr);
+  if (!device)
+    throw std::runtime_error("camera '" + camera.name + "': Embree could not start (rtcNewDevice failed)");
+  scene = rtcNewScene(device);
+  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
+
+  for (std::size_t b = 0; b < model.bodies.size(); ++b)
+  {
+    const BodyRange& range = model.bodies[b];
+    const Look& look = range.look;
+    const Owner owner{ static_cast<std::uint16_t>(1 + b), look.color };
+    Body body;
+    body.look = &look;
+    body.first = range.first;
+    body.count = range.count;
+    if (!look.faces.empty())
+    {
+      std::vector<std::array<unsigned, 3>> faces;
+      for (const std::array<int, 3>& face : look.faces)
+        faces.push_back({ static_cast<unsigned>(face[0] - range.first), static_cast<unsigned>(face[1] - range.first),
+                          static_cast<unsigned>(face[2] - range.first) });
+      body.faces = addTriangles(owner, static_cast<std::size_t>(range.count), faces);
+    }
+    if (!look.tubes.empty())
+      body.tubes = addSegments(RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE, owner, look.tubes.size());
+    if (!look.balls.empty())
+      body.balls = addPoints(owner, look.balls.size());
+    bodies.push_back(body);
+  }
+
+  // Mask values follow ~state's colliders: the named planes, then every shape in placements() order.
+  std::uint16_t index = kColliderMask;
+  for (const Plane& plane : model.colliders.planes)
+  {
+    if (!plane.name.empty())
+      ++index;
+    std::vector<std::array<unsigned, 3>> square = { { 0, 1, 2 }, { 0, 2, 3 } };
+    planes.push_back({ plane, addTriangles(Owner{ 0, plane.color }, 4, square) });
+  }
+  const auto shape = [&](const ColliderPlacement& at, ColliderPose::Shape kind) {
+    Collider collider;
+    collider.name = at.name;
+    collider.shape = kind;
+    const Owner owner{ index++, at.color };
+    std::vector<std::array<unsigned, 3>> box;
+    switch (kind)
+    {
+      case ColliderPose::Shape::Sphere:
+        collider.geometry = addPoints(owner, 1);
+        break;
+      case ColliderPose::Shape::Capsule:
+        collider.geometry = addSegments(RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE, owner, 1);
+        break;
+      case ColliderPose::Shape::Cylinder:
+        collider.geometry = addSegments(RTC_GEOMETRY_TYPE_CONE_LINEAR_CURVE, owner, 1);
+        break;
+      case ColliderPose::Shape::Box:
+        for (const auto& t : kBoxTriangles)
+          box.push_back({ t[0], t[1], t[2] });
+        collider.geometry = addTriangles(owner, 8, box);
+        break;
+      case ColliderPose::Shape::Mesh:
+        break;
+    }
+    return collider;
+  };
+  for (const Sphere& s : model.colliders.spheres)
+  {
+    colliders.push_back(shape(s.at, ColliderPose::Shape::Sphere));
+    colliders.back().radius = s.radius;
+  }
+  for (const Capsule& c : model.colliders.capsules)
+  {
+    colliders.push_back(shape(c.at, ColliderPose::Shape::Capsule));
+    colliders.back().radius = c.radius;
+    colliders.back().length = c.length;
+  }
+  for (const Box& b : model.colliders.boxes)
+  {
+    colliders.push_back(shape(b.at, ColliderPose::Shape::Box));
+    colliders.back().size = b.size;
+  }
+  for (const Cylinder& c : model.colliders.cylinders)
+  {
+    colliders.push_back(shape(c.at, ColliderPose::Shape::Cylinder));
+    colliders.back().radius = c.radius;
+    colliders.back().length = c.length;
+  }
+  for (const Mesh& m : model.colliders.meshes)
+  {
+    Collider collider = shape(m.at, ColliderPose::Shape::Mesh);
+    collider.mesh = m.triangles;
+    if (m.triangles && !m.triangles->triangles.empty())
+    {
+      std::vector<std::array<unsigned, 3>> triangles;
+      for (const Eigen::Vector3i& t : m.triangles->triangles)
+        triangles.push_back({ static_cast<unsigned>(t[0]), static_cast<unsigned>(t[1]), static_cast<unsigned>(t[2]) });
+      collider.geometry =
+          addTriangles(Owner{ static_cast<std::uint16_t>(index - 1), m.at.color }, m.triangles->vertices.size(), triangles);
+    }
+    colliders.push_back(collider);
+  }
+}
+
+void DepthCamera::Scene::placeBodies(const State& state, const Vec3& eye) const
+{
+  for (const Body& body : bodies)
+  {
+    const Look& look = *body.look;
+    const auto node = [&](int i) { return relative(state.position.col(i), eye); };
+    if (body.faces != RTC_INVALID_GEOMETRY_ID)
+    {
+      float* v = vertices(body.faces);
+      for (int i = 0; i < body.count; ++i)
+        put(v + 3 * i, node(body.first + i));
+      commit(body.faces);
+    }
+    const auto ball = [&](float* at, int i) {
+      put(at, node(i));
+      at[3] = static_cast<float>(look.radius);
+    };
+    if (body.tubes != RTC_INVALID_GEOMETRY_ID)
+    {
+      float* v = vertices(body.tubes);
+      for (std::size_t k = 0; k < look.tubes.size(); ++k)
+      {
+        ball(v + 8 * k, look.tubes[k].first);
+        ball(v + 8 * k + 4, look.tubes[k].second);
+      }
+      commit(body.tubes);
+    }
+    if (body.balls != RTC_INVALID_GEOMETRY_ID)
+    {
+      float* v = vertices(body.balls);
+      for (std::size_t k = 0; k < look.balls.size(); ++k)
+        ball(v + 4 * k, look.balls[k]);
+      commit(body.balls);
+    }
+  }
+}
+
+void DepthCamera::Scene::placeColliders(const std::vector<ColliderPose>& poses, const Vec3& eye)
+{
+  for (Collider& collider : colliders)
+  {
+    if (collider.geometry == RTC_INVALID_GEOMETRY_ID)
+      continue;
+    const ColliderPose* pose = nullptr;
+    for (const ColliderPose& p : poses)
+      if (p.name == collider.name)
+        pose = &p;
+    RTCGeometry geometry = rtcGetGeometry(scene, collider.geometry);
+    if (!pose)
+    {
+      if (collider.enabled)
+        rtcDisableGeometry(geometry);
+      collider.enabled = false;
+      continue;
+    }
+    if (!collider.enabled)
+      rtcEnableGeometry(geometry);
+    collider.enabled = true;
+    const Eigen::Quaterniond turn = pose->orientation.normalized();
+    const auto local = [&](const Vec3& p) { return relative(pose->position + turn * p, eye); };
+    float* v = vertices(collider.geometry);
+    switch (collider.shape)
+    {
+      case ColliderPose::Shape::Sphere:
+        put(v, local(Vec3::Zero()));
+        v[3] = static_cast<float>(collider.radius);
+        break;
+      case ColliderPose::Shape::Capsule:
+      case ColliderPose::Shape::Cylinder:
+        for (const int end : { 0, 1 })
+        {
+          put(v + 4 * end, local(Vec3(0.0, 0.0, (end == 0 ? -0.5 : 0.5) * collider.length)));
+          v[4 * end + 3] = static_cast<float>(collider.radius);
+        }
+        break;
+      case ColliderPose::Shape::Box:
+        for (int k = 0; k < 8; ++k)
+        {
+          const Vec3 corner(k & 1 ? 0.5 : -0.5, k & 2 ? 0.5 : -0.5, k & 4 ? 0.5 : -0.5);
+          put(v + 3 * k, local(corner.cwiseProduct(collider.size)));
+        }
+        break;
+      case ColliderPose::Shape::Mesh:
+        for (std::size_t k = 0; k < collider.mesh->vertices.size(); ++k)
+          put(v + 3 * k, local(collider.mesh->vertices[k]));
+        break;
+    }
+    commit(collider.geometry);
+  }
+}
+
+void DepthCamera::Scene::placePlanes(const Vec3& eye) const
+{
+  const double reach = kPlaneReach * def.max_range;
+  for (const PlaneGeometry& at : planes)
+  {
+    const Vec3 n = at.plane.normal.normalized();
+    const Vec3 foot = eye - n * n.dot(eye - at.plane.point);
+    const Vec3 t1 = n.unitOrthogonal() * reach;
+    const Vec3 t2 = n.cross(t1);
+    float* v = vertices(at.geometry);
+    const Vec3 corners[4] = { foot - t1 - t2, foot + t1 - t2, foot + t1 + t2, foot - t1 + t2 };
+    for (int k = 0; k < 4; ++k)
+      put(v + 3 * k, relative(corners[k], eye));
+    commit(at.geometry);
+  }
+}
+
+DepthCamera::DepthCamera(const CameraDef& camera, const Model& model)
+{
+  checkCamera(camera);
+  scene_ = std::make_unique<Scene>(camera, model);
+}
+
+DepthCamera::~DepthCamera() = default;
+
+const CameraIntrinsics& DepthCamera::intrinsics() const { return scene_->intrinsics; }
+
+CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
+                                std::uint64_t frame_number)
+{
+  Scene& s = *scene_;
+  const Vec3 eye = link.position;
+  s.placeBodies(state, eye);
+  s.placeColliders(colliders, eye);
+  s.placePlanes(eye);
+  rtcCommitScene(s.scene);
+
+  const CameraIntrinsics& k = s.intrinsics;
+  const CameraDef& def = s.def;
+  CameraImage image;
+  image.width = k.width;
+  image.height = k.height;
+  const std::size_t pixels = static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height);
+  image.depth.assign(pixels, std::numeric_limits<float>::quiet_NaN());
+  image.color.assign(3 * pixels, 0);
+  image.mask.assign(pixels, 0);
+  // The optical frame's axes in the scene frame: a pixel's ray (x, y, 1) in it has t = z along it.
+  const Eigen::Matrix3f optical = (link.orientation.normalized() * linkToOptical()).toRotationMatrix().cast<float>();
+  std::mt19937_64 random(def.noise ? def.noise->seed ^ (0x9E3779B97F4A7C15ull * (frame_number + 1)) : 0);
+  std::normal_distribution<double> unit_normal(0.0, 1.0);
+  RTCIntersectContext context;
+  rtcInitIntersectContext(&context);
+  const auto channel = [](double value) { return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(value, 0.0, 1.0))); };
+  for (int v = 0; v < k.height; ++v)
+    for (int u = 0; u < k.width; ++u)
+    {
+      const std::size_t pixel = static_cast<std::size_t>(v) * static_cast<std::size_t>(k.width) + static_cast<std::size_t>(u);
+      const Eigen::Vector3f direction =
+          optical * Eigen::Vector3f(static_cast<float>((u - k.cx) / k.fx), static_cast<float>((v - k.cy) / k.fy), 1.0f);
+      RTCRayHit hit;
+      hit.ray.org_x = hit.ray.org_y = hit.ray.org_z = 0.0f;
+      hit.ray.dir_x = direction.x();
+      hit.ray.dir_y = direction.y();
+      hit.ray.dir_z = direction.z();
+      hit.ray.tnear = 0.0f;
+      hit.ray.tfar = std::numeric_limits<float>::infinity();
+      hit.ray.time = 0.0f;
+      hit.ray.mask = ~0u;
+      hit.ray.id = 0;
+      hit.ray.flags = 0;
+      hit.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+      hit.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      rtcIntersect1(s.scene, &context, &hit);
+      Eigen::Vector3d color = def.background;
+      if (hit.hit.geomID != RTC_INVALID_GEOMETRY_ID)
+      {
+        const Owner& owner = s.owners[hit.hit.geomID];
+        image.mask[pixel] = owner.mask;
+        const Eigen::Vector3f normal(hit.hit.Ng_x, hit.hit.Ng_y, hit.hit.Ng_z);
+        const float norms = normal.norm() * direction.norm();
+        const double lambert = norms > 0.0f ? std::abs(normal.dot(direction)) / norms : 0.0;
+        color = owner.color * lambert;
+        const double z = hit.ray.tfar;
+        if (z >= def.min_range && z <= def.max_range)
+        {
+          const double noise = def.noise ? def.noise->depth_stddev * z * z * unit_normal(random) : 0.0;
+          image.depth[pixel] = static_cast<float>(z + noise);
+        }
+      }
+      for (int c = 0; c < 3; ++c)
+        image.color[3 * pixel + static_cast<std::size_t>(c)] = channel(color[c]);
+    }
+  return image;
+}
+
+}  // namespace soft_body_sim
