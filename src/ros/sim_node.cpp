@@ -40,6 +40,10 @@ void SimNode::initialize()
   scene_ = loadSceneFile(scene_path_);
   if (scene_.robot_colliders)
     addRobotColliders();
+  for (const CameraDef& camera : scene_.cameras)
+    ROS_WARN("%s: %s: camera '%s' takes no pictures in the ROS node; the headless simulator renders it "
+             "(scripts/simulate --scene ... --images DIR)",
+             name_.c_str(), scene_path_.c_str(), camera.name.c_str());
   rate_ = readParam<double>(private_nh_, "rate", "a finite number > 0 [Hz]", finitePositive).value_or(scene_.rate);
   // Below one tick's period, so that a tick leaves time for the callbacks (services, inputs) before the next.
   tick_budget_ =
