@@ -40,10 +40,6 @@ void SimNode::initialize()
   scene_ = loadSceneFile(scene_path_);
   if (scene_.robot_colliders)
     addRobotColliders();
-  for (const CameraDef& camera : scene_.cameras)
-    ROS_WARN("%s: %s: camera '%s' takes no pictures in the ROS node; the headless simulator renders it "
-             "(scripts/simulate --scene ... --images DIR)",
-             name_.c_str(), scene_path_.c_str(), camera.name.c_str());
   rate_ = readParam<double>(private_nh_, "rate", "a finite number > 0 [Hz]", finitePositive).value_or(scene_.rate);
   // Below one tick's period, so that a tick leaves time for the callbacks (services, inputs) before the next.
   tick_budget_ =
@@ -75,6 +71,7 @@ void SimNode::initialize()
   start_time_publisher_ = private_nh_.advertise<std_msgs::Time>("start_time", 1, true);
   subscribeInputs();
   addHandles();
+  addCameras();
   startReconfigure();
   diagnostics_ = std::make_unique<diagnostic_updater::Updater>(nh_, private_nh_, name_);
   diagnostics_->setHardwareID("none");  // a simulation: no device
@@ -135,6 +132,55 @@ void SimNode::buildWorldFromScene()
   inputs_.clear();
   glides_.clear();
   target_glides_.clear();
+  for (const std::unique_ptr<CameraPublisher>& camera : cameras_)
+    camera->restart();
+}
+
+void SimNode::addCameras()
+{
+  if (scene_.cameras.empty())
+    return;
+  camera_frames_ = std::make_unique<tf2_ros::StaticTransformBroadcaster>();
+  std::vector<geometry_msgs::TransformStamped> frames;
+  const auto transform = [&](const std::string& parent, const std::string& child, const RigidPose& pose) {
+    geometry_msgs::TransformStamped t;
+    t.header.stamp = ros::Time::now();
+    t.header.frame_id = parent;
+    t.child_frame_id = child;
+    t.transform.translation.x = pose.position.x();
+    t.transform.translation.y = pose.position.y();
+    t.transform.translation.z = pose.position.z();
+    t.transform.rotation = RosConverter::toPose(pose).orientation;
+    frames.push_back(t);
+  };
+  for (const CameraDef& camera : scene_.cameras)
+  {
+    cameras_.push_back(std::make_unique<CameraPublisher>(camera, world_->model(), private_nh_));
+    transform(camera.frame.empty() ? scene_.frame_id : camera.frame, camera.name + "_link",
+              RigidPose{ camera.position, camera.orientation.normalized() });
+    transform(camera.name + "_link", camera.name + "_color_optical_frame", RigidPose{ Vec3::Zero(), linkToOptical() });
+  }
+  camera_frames_->sendTransform(frames);
+}
+
+void SimNode::shootCameras(const ros::Time& stamp)
+{
+  const double t = world_->time();
+  for (const std::unique_ptr<CameraPublisher>& camera : cameras_)
+  {
+    if (!camera->due(t))
+      continue;
+    const CameraDef& def = camera->def();
+    RigidPose link{ def.position, def.orientation.normalized() };
+    if (!def.frame.empty())
+    {
+      const std::optional<RigidPose> frame = framePose(def.frame, stamp);  // warns (throttled) if there is none
+      if (!frame)
+        continue;
+      link = RigidPose{ frame->position + frame->orientation * link.position, frame->orientation * link.orientation };
+    }
+    camera->shoot(world_->state(), world_->colliderPoses(), link, stamp, t);
+  }
 }
 
 void SimNode::onTimer(const ros::TimerEvent&)
@@ -256,6 +302,7 @@ void SimNode::publish()
                        name_.c_str());
     return;
   }
+  shootCameras(stamp);
   const std::vector<Holder> holders = RosConverter::holders(*world_);
   markers_publisher_.publish(RosConverter::toMarkers(*world_, scene_.frame_id, stamp));
   force_markers_publisher_.publish(RosConverter::toForceMarkers(holders, force_scale_, scene_.frame_id, stamp));

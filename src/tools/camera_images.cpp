@@ -55,18 +55,6 @@ void writePng(const std::string& path, int width, int height, int channels, int 
 }
 }  // namespace
 
-std::vector<std::uint16_t> depthMillimetres(const CameraImage& image)
-{
-  std::vector<std::uint16_t> millimetres(image.depth.size(), 0);
-  for (std::size_t k = 0; k < image.depth.size(); ++k)
-  {
-    const double mm = std::round(1000.0 * static_cast<double>(image.depth[k]));
-    if (mm >= 1.0 && mm <= 65535.0)  // NaN fails both
-      millimetres[k] = static_cast<std::uint16_t>(mm);
-  }
-  return millimetres;
-}
-
 void writeCameraImages(const std::string& directory, const std::string& camera, std::uint64_t frame,
                        const CameraImage& image)
 {

@@ -1,7 +1,8 @@
 // Every conversion between the core and ROS messages, in one place (as grid_map's
 // GridMapRosConverter): markers and state out, poses in, reconfigure configs both ways. Plain functions
 // of plain data, unit-tested without a ROS master. One class, a source file per kind of message:
-// src/ros/marker_conversion.cpp, state_conversion.cpp, pose_conversion.cpp, reconfigure_conversion.cpp.
+// src/ros/marker_conversion.cpp, state_conversion.cpp, pose_conversion.cpp, reconfigure_conversion.cpp,
+// camera_conversion.cpp.
 #pragma once
 
 #include <string>
@@ -15,11 +16,16 @@
 #include <geometry_msgs/Vector3.h>
 #include <geometry_msgs/WrenchStamped.h>
 #include <ros/time.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/Header.h>
 #include <visualization_msgs/MarkerArray.h>
 
 #include "soft_body_sim/BodyConfig.h"
 #include "soft_body_sim/SimConfig.h"
 #include "soft_body_sim/SimState.h"
+#include "soft_body_sim/core/sensing/depth_camera.h"
 #include "soft_body_sim/core/world.h"
 
 namespace soft_body_sim
@@ -106,6 +112,25 @@ public:
   static std::optional<RigidPose> toRigidPose(const geometry_msgs::Transform& transform);
   /// A pose as a rigid pose; nullopt if any field is not finite or the orientation is zero.
   static std::optional<RigidPose> toRigidPose(const geometry_msgs::Pose& pose);
+
+  // --- camera images (camera_conversion.cpp) ---
+
+  /// The camera's pinhole model (CameraIntrinsics) as its CameraInfo: K, P (no baseline), R the identity,
+  /// no distortion ("plumb_bob", all zeros).
+  static sensor_msgs::CameraInfo toCameraInfo(const CameraIntrinsics& intrinsics, const std_msgs::Header& header);
+  /// The colour image, rgb8.
+  static sensor_msgs::Image toColorImage(const CameraImage& image, const std_msgs::Header& header);
+  /// The depth as 16UC1 millimetres, 0 = no return (as the RealSense driver's aligned depth).
+  static sensor_msgs::Image toDepthMillimetres(const CameraImage& image, const std_msgs::Header& header);
+  /// The depth as 32FC1 metres, NaN = no return (REP 118).
+  static sensor_msgs::Image toDepthMetres(const CameraImage& image, const std_msgs::Header& header);
+  /// The mask, 16UC1 (CameraImage::mask).
+  static sensor_msgs::Image toMask(const CameraImage& image, const std_msgs::Header& header);
+  /// The organised cloud (height x width) of the depth back-projected with the intrinsics, in the optical
+  /// frame: fields x, y, z and rgb as float32 (rgb packed as PCL does, 0x00RRGGBB in a float's bits); NaN
+  /// where there is no return.
+  static sensor_msgs::PointCloud2 toPointCloud(const CameraImage& image, const CameraIntrinsics& intrinsics,
+                                               const std_msgs::Header& header);
 
   // --- dynamic_reconfigure configs (reconfigure_conversion.cpp) ---
 

@@ -22,6 +22,7 @@
 #include <std_srvs/Empty.h>
 #include <std_srvs/SetBool.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/static_transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
 #include "soft_body_sim/Attach.h"
@@ -31,6 +32,7 @@
 #include "soft_body_sim/SimConfig.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/ros/anchor_handles.h"
+#include "soft_body_sim/ros/camera_publisher.h"
 #include "soft_body_sim/ros/input_glide.h"
 #include "soft_body_sim/ros/input_schedule.h"
 #include "soft_body_sim/ros/reconfigure_server.h"
@@ -115,6 +117,11 @@ private:
   void addRobotColliders();
   /// A collider with a tf frame follows it: its scene pose is relative to the frame.
   void followFrame(const ColliderPlacement& collider);
+  /// The scene's cameras: their publishers and their static tf frames (<name>_link under the scene frame
+  /// or their `frame`, <name>_color_optical_frame under it).
+  void addCameras();
+  /// Each camera whose frame is due at the world's time takes it, stamped `stamp`.
+  void shootCameras(const ros::Time& stamp);
   bool onAttach(Attach::Request& request, Attach::Response& response);
   bool onDetach(Detach::Request& request, Detach::Response& response);
   bool onGrasp(Grasp::Request& request, Grasp::Response& response);
@@ -191,6 +198,8 @@ private:
   std::map<int, InputGlide> glides_;  ///< per anchor index, once it has had an input
   std::map<std::string, InputGlide> target_glides_;  ///< per body, once it has had a target
   std::uint64_t pauses_ = 0;  ///< ticks spent paused since the start: a frame's glide restarts after one
+  std::vector<std::unique_ptr<CameraPublisher>> cameras_;  ///< the scene's cameras; none: nothing made
+  std::unique_ptr<tf2_ros::StaticTransformBroadcaster> camera_frames_;  ///< their links and optical frames
   std::vector<std::string> handle_names_;  ///< per scene anchor: its handle ("" = follows a frame)
   std::vector<std::pair<std::string, std::string>> target_handles_;  ///< (body, handle) per target
   std::map<std::string, Vec3> targets_;  ///< last target set per body [m]

@@ -10,10 +10,6 @@
 
 namespace soft_body_sim
 {
-/// The depth image as 16-bit millimetres, 0 = no return (as sensor_msgs 16UC1 and the RealSense driver
-/// write it); depths beyond 65.535 m are 0 too.
-std::vector<std::uint16_t> depthMillimetres(const CameraImage& image);
-
 /// Writes `<directory>/<camera>_color_<frame>.png` (8-bit rgb), `<camera>_depth_<frame>.png` (16-bit grey,
 /// depthMillimetres) and `<camera>_mask_<frame>.png` (16-bit grey, CameraImage::mask), the frame number
 /// zero-padded to six digits so that names sort in time. Throws std::runtime_error naming a file it cannot

@@ -49,7 +49,7 @@ struct DepthCamera::Scene
   /// A body's geometries (Look): its faces, tubes and balls, each absent (RTC_INVALID_GEOMETRY_ID) if empty.
   struct Body
   {
-    const Look* look = nullptr;
+    Look look;  ///< a copy: the camera outlives a reset's new model
     int first = 0, count = 0;
     unsigned faces = RTC_INVALID_GEOMETRY_ID, tubes = RTC_INVALID_GEOMETRY_ID, balls = RTC_INVALID_GEOMETRY_ID;
   };
@@ -162,7 +162,7 @@ DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
     const Look& look = range.look;
     const Owner owner{ static_cast<std::uint16_t>(1 + b), look.color };
     Body body;
-    body.look = &look;
+    body.look = look;
     body.first = range.first;
     body.count = range.count;
     if (!look.faces.empty())
@@ -258,7 +258,7 @@ void DepthCamera::Scene::placeBodies(const State& state, const Vec3& eye) const
 {
   for (const Body& body : bodies)
   {
-    const Look& look = *body.look;
+    const Look& look = body.look;
     const auto node = [&](int i) { return relative(state.position.col(i), eye); };
     if (body.faces != RTC_INVALID_GEOMETRY_ID)
     {
@@ -360,6 +360,18 @@ void DepthCamera::Scene::placePlanes(const Vec3& eye) const
       put(v + 3 * k, relative(corners[k], eye));
     commit(at.geometry);
   }
+}
+
+std::vector<std::uint16_t> depthMillimetres(const CameraImage& image)
+{
+  std::vector<std::uint16_t> millimetres(image.depth.size(), 0);
+  for (std::size_t k = 0; k < image.depth.size(); ++k)
+  {
+    const double mm = std::round(1000.0 * static_cast<double>(image.depth[k]));
+    if (mm >= 1.0 && mm <= 65535.0)  // NaN fails both
+      millimetres[k] = static_cast<std::uint16_t>(mm);
+  }
+  return millimetres;
 }
 
 DepthCamera::DepthCamera(const CameraDef& camera, const Model& model)

@@ -41,10 +41,15 @@ struct CameraImage
   std::vector<std::uint16_t> mask;
 };
 
+/// The depth as whole millimetres, 0 = no return (sensor_msgs 16UC1, as the RealSense driver writes it;
+/// beyond 65.535 m no return either).
+std::vector<std::uint16_t> depthMillimetres(const CameraImage& image);
+
 class DepthCamera
 {
 public:
-  /// The camera `camera` (checked: checkCamera) on the scene `model` (its bodies' Look, its colliders).
+  /// The camera `camera` (checked: checkCamera) on the scene `model` (its bodies' Look, its colliders;
+  /// copied: a model rebuilt from the same scene, as by a reset, is seen as well).
   DepthCamera(const CameraDef& camera, const Model& model);
   ~DepthCamera();
   DepthCamera(const DepthCamera&) = delete;
