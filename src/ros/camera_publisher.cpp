@@ -50,10 +50,7 @@ void CameraPublisher::shoot(const State& state, const std::vector<ColliderPose>&
   frame_ = frame + 1;
   std::lock_guard<std::mutex> lock(mutex_);
   if (!watched())
-  {
-    dropped_ += skipped + 1;
     return;
-  }
   dropped_ += skipped + (pending_ ? 1 : 0);
   pending_ = Job{ state, colliders, link, stamp, frame };
   wake_.notify_one();

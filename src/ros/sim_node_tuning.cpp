@@ -219,6 +219,8 @@ void SimNode::diagnose(diagnostic_updater::DiagnosticStatusWrapper& status)
   status.add("integrator", integratorName(world_->integrator()));
   status.add("dt [s]", world_->settings().dt);
   status.add("nodes", world_->model().nodeCount());
+  for (const std::unique_ptr<CameraPublisher>& camera : cameras_)
+    status.add("camera " + camera->def().name + ": frames dropped", camera->dropped());
 }
 
 }  // namespace soft_body_sim

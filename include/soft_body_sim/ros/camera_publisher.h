@@ -42,7 +42,8 @@ public:
   /// is this one if nobody listens.
   void shoot(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
              const ros::Time& stamp, double t);
-  /// Frames skipped because it was busy (or nobody listened), since the start.
+  /// Frames someone listened for that were skipped, since the start: the render thread was busy (a frame
+  /// still waiting replaced by the next) or a tick took more than a frame's period.
   std::uint64_t dropped() const;
   /// From simulated time 0 again (a reset).
   void restart() { frame_ = 0; }
