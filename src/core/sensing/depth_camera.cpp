@@ -413,9 +413,15 @@ CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPo
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
-  const auto channel = [](double value) { return static_cast<std::uint8_t>(std::lround(255.0 * std::clamp(value, 0.0, 1.0))); };
+  // Rounded to the nearest of 0..255 (std::lround's call cost a fifth of the frame).
+  const auto channel = [](double value) { return static_cast<std::uint8_t>(255.0 * std::clamp(value, 0.0, 1.0) + 0.5); };
   constexpr int kLanes = 8;
+  // A pixel's ray is linear in its column: the row's first ray plus u times the step between columns.
+  const Eigen::Vector3f column_step = optical * Eigen::Vector3f(static_cast<float>(1.0 / k.fx), 0.0f, 0.0f);
   for (int v = 0; v < k.height; ++v)
+  {
+    const Eigen::Vector3f row_start =
+        optical * Eigen::Vector3f(static_cast<float>(-k.cx / k.fx), static_cast<float>((v - k.cy) / k.fy), 1.0f);
     for (int u0 = 0; u0 < k.width; u0 += kLanes)
     {
       alignas(32) int valid[kLanes];
@@ -425,8 +431,7 @@ CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPo
       {
         const int u = std::min(u0 + i, k.width - 1);
         valid[i] = u0 + i < k.width ? -1 : 0;
-        directions[i] =
-            optical * Eigen::Vector3f(static_cast<float>((u - k.cx) / k.fx), static_cast<float>((v - k.cy) / k.fy), 1.0f);
+        directions[i] = row_start + static_cast<float>(u) * column_step;
         rays.ray.org_x[i] = rays.ray.org_y[i] = rays.ray.org_z[i] = 0.0f;
         rays.ray.dir_x[i] = directions[i].x();
         rays.ray.dir_y[i] = directions[i].y();
@@ -465,6 +470,7 @@ CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPo
           image.color[3 * pixel + static_cast<std::size_t>(c)] = channel(color[c]);
       }
     }
+  }
   return image;
 }
 
