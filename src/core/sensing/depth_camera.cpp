@@ -54,13 +54,11 @@ struct DepthCamera::Scene
     int first = 0, count = 0;
     unsigned faces = RTC_INVALID_GEOMETRY_ID, tubes = RTC_INVALID_GEOMETRY_ID, balls = RTC_INVALID_GEOMETRY_ID;
   };
-  /// A shape collider's geometry, by its name.
+  /// A shape collider's geometry: its shape, size and name as ColliderPose::of gives them (the pose is the
+  /// frame's), a mesh's triangles.
   struct Collider
   {
-    std::string name;
-    ColliderPose::Shape shape = ColliderPose::Shape::Sphere;
-    double radius = 0.0, length = 0.0;  ///< [m] sphere, capsule, cylinder
-    Vec3 size = Vec3::Zero();           ///< [m] box
+    ColliderPose shape;
     std::shared_ptr<const TriangleMesh> mesh;
     unsigned geometry = RTC_INVALID_GEOMETRY_ID;
     bool enabled = true;
@@ -190,13 +188,11 @@ DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
     std::vector<std::array<unsigned, 3>> square = { { 0, 1, 2 }, { 0, 2, 3 } };
     planes.push_back({ plane, addTriangles(Owner{ 0, plane.color }, 4, square) });
   }
-  const auto shape = [&](const ColliderPlacement& at, ColliderPose::Shape kind) {
-    Collider collider;
-    collider.name = at.name;
-    collider.shape = kind;
-    const Owner owner{ index++, at.color };
-    std::vector<std::array<unsigned, 3>> box;
-    switch (kind)
+  const auto addShape = [&](const ColliderPose& shape, const std::shared_ptr<const TriangleMesh>& mesh) {
+    Collider collider{ shape, mesh };
+    const Owner owner{ index++, shape.color };
+    std::vector<std::array<unsigned, 3>> triangles;
+    switch (shape.shape)
     {
       case ColliderPose::Shape::Sphere:
         collider.geometry = addPoints(owner, 1);
@@ -209,50 +205,29 @@ DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
         break;
       case ColliderPose::Shape::Box:
         for (const auto& t : kBoxTriangles)
-          box.push_back({ t[0], t[1], t[2] });
-        collider.geometry = addTriangles(owner, 8, box);
+          triangles.push_back({ t[0], t[1], t[2] });
+        collider.geometry = addTriangles(owner, 8, triangles);
         break;
       case ColliderPose::Shape::Mesh:
+        if (!mesh || mesh->triangles.empty())
+          break;
+        for (const Eigen::Vector3i& t : mesh->triangles)
+          triangles.push_back({ static_cast<unsigned>(t[0]), static_cast<unsigned>(t[1]), static_cast<unsigned>(t[2]) });
+        collider.geometry = addTriangles(owner, mesh->vertices.size(), triangles);
         break;
     }
-    return collider;
-  };
-  for (const Sphere& s : model.colliders.spheres)
-  {
-    colliders.push_back(shape(s.at, ColliderPose::Shape::Sphere));
-    colliders.back().radius = s.radius;
-  }
-  for (const Capsule& c : model.colliders.capsules)
-  {
-    colliders.push_back(shape(c.at, ColliderPose::Shape::Capsule));
-    colliders.back().radius = c.radius;
-    colliders.back().length = c.length;
-  }
-  for (const Box& b : model.colliders.boxes)
-  {
-    colliders.push_back(shape(b.at, ColliderPose::Shape::Box));
-    colliders.back().size = b.size;
-  }
-  for (const Cylinder& c : model.colliders.cylinders)
-  {
-    colliders.push_back(shape(c.at, ColliderPose::Shape::Cylinder));
-    colliders.back().radius = c.radius;
-    colliders.back().length = c.length;
-  }
-  for (const Mesh& m : model.colliders.meshes)
-  {
-    Collider collider = shape(m.at, ColliderPose::Shape::Mesh);
-    collider.mesh = m.triangles;
-    if (m.triangles && !m.triangles->triangles.empty())
-    {
-      std::vector<std::array<unsigned, 3>> triangles;
-      for (const Eigen::Vector3i& t : m.triangles->triangles)
-        triangles.push_back({ static_cast<unsigned>(t[0]), static_cast<unsigned>(t[1]), static_cast<unsigned>(t[2]) });
-      collider.geometry =
-          addTriangles(Owner{ static_cast<std::uint16_t>(index - 1), m.at.color }, m.triangles->vertices.size(), triangles);
-    }
     colliders.push_back(collider);
-  }
+  };
+  for (const Sphere& sphere : model.colliders.spheres)
+    addShape(ColliderPose::of(sphere), nullptr);
+  for (const Capsule& capsule : model.colliders.capsules)
+    addShape(ColliderPose::of(capsule), nullptr);
+  for (const Box& box : model.colliders.boxes)
+    addShape(ColliderPose::of(box), nullptr);
+  for (const Cylinder& cylinder : model.colliders.cylinders)
+    addShape(ColliderPose::of(cylinder), nullptr);
+  for (const Mesh& mesh : model.colliders.meshes)
+    addShape(ColliderPose::of(mesh), mesh.triangles);
 }
 
 void DepthCamera::Scene::placeBodies(const State& state, const Vec3& eye) const
@@ -300,7 +275,7 @@ void DepthCamera::Scene::placeColliders(const std::vector<ColliderPose>& poses, 
       continue;
     const ColliderPose* pose = nullptr;
     for (const ColliderPose& p : poses)
-      if (p.name == collider.name)
+      if (p.name == collider.shape.name)
         pose = &p;
     RTCGeometry geometry = rtcGetGeometry(scene, collider.geometry);
     if (!pose)
@@ -316,25 +291,29 @@ void DepthCamera::Scene::placeColliders(const std::vector<ColliderPose>& poses, 
     const Eigen::Quaterniond turn = pose->orientation.normalized();
     const auto local = [&](const Vec3& p) { return relative(pose->position + turn * p, eye); };
     float* v = vertices(collider.geometry);
-    switch (collider.shape)
+    // ColliderPose's size: a sphere's diameter thrice, a capsule's or cylinder's (diameter, diameter,
+    // length), a box's edges.
+    const Vec3& size = collider.shape.size;
+    const float radius = static_cast<float>(0.5 * size.x());
+    switch (collider.shape.shape)
     {
       case ColliderPose::Shape::Sphere:
         put(v, local(Vec3::Zero()));
-        v[3] = static_cast<float>(collider.radius);
+        v[3] = radius;
         break;
       case ColliderPose::Shape::Capsule:
       case ColliderPose::Shape::Cylinder:
         for (const int end : { 0, 1 })
         {
-          put(v + 4 * end, local(Vec3(0.0, 0.0, (end == 0 ? -0.5 : 0.5) * collider.length)));
-          v[4 * end + 3] = static_cast<float>(collider.radius);
+          put(v + 4 * end, local(Vec3(0.0, 0.0, (end == 0 ? -0.5 : 0.5) * size.z())));
+          v[4 * end + 3] = radius;
         }
         break;
       case ColliderPose::Shape::Box:
         for (int k = 0; k < 8; ++k)
         {
           const Vec3 corner(k & 1 ? 0.5 : -0.5, k & 2 ? 0.5 : -0.5, k & 4 ? 0.5 : -0.5);
-          put(v + 3 * k, local(corner.cwiseProduct(collider.size)));
+          put(v + 3 * k, local(corner.cwiseProduct(size)));
         }
         break;
       case ColliderPose::Shape::Mesh:

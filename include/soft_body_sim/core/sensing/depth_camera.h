@@ -25,7 +25,8 @@
 
 namespace soft_body_sim
 {
-/// The mask value of collider k (its index in ColliderIndex's order): kColliderMask + k.
+/// The mask value of collider k (its index in ~state's `colliders`: the named planes, then the shapes in
+/// placements() order): kColliderMask + k.
 constexpr std::uint16_t kColliderMask = 1000;
 
 /// One frame of a camera, row by row from the top left pixel.
