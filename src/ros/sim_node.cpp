@@ -177,7 +177,7 @@ void SimNode::shootCameras(const ros::Time& stamp)
       const std::optional<RigidPose> frame = framePose(def.frame, stamp);  // warns (throttled) if there is none
       if (!frame)
         continue;
-      link = RigidPose{ frame->position + frame->orientation * link.position, frame->orientation * link.orientation };
+      link = compose(*frame, link);
     }
     camera->shoot(world_->state(), world_->colliderPoses(), link, stamp, t);
   }

@@ -420,7 +420,7 @@ void SimNode::followFrame(const ColliderPlacement& collider)
     const std::optional<RigidPose> origin = followedPose(frame, t, *glide);
     if (!origin)
       return std::nullopt;
-    return RigidPose{ origin->position + origin->orientation * local.position, origin->orientation * local.orientation };
+    return compose(*origin, local);
   });
 }
 

@@ -71,6 +71,13 @@ struct RigidPose
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
 };
 
+/// `local`, a pose in the frame that `frame` places, in the frame's parent (a tf child's pose composed with
+/// its parent's).
+inline RigidPose compose(const RigidPose& frame, const RigidPose& local)
+{
+  return { frame.position + frame.orientation * local.position, frame.orientation * local.orientation };
+}
+
 /// Where a collider should be at simulated time t [s]; nullopt = not known (it then holds still).
 using ColliderPath = std::function<std::optional<RigidPose>(double t)>;
 
