@@ -199,16 +199,22 @@ TEST(DepthCamera, ASphereBeforeACanvasOfClothHidesItsPart)
   EXPECT_TRUE(std::isnan(image.depth[at(image, 2, 60)]));
 }
 
-/// The standard deviation [m] of a flat face's depth at `distance` straight ahead, and the image.
-std::pair<double, CameraImage> spread(double distance, std::uint64_t seed, std::uint64_t frame)
+/// A wall 2 cm thick and `extent` [m] wide and high, its face `distance` [m] along +x from the origin.
+Colliders wallAhead(double distance, double extent)
 {
   Box box;
   box.at.name = "wall";
-  box.size = Vec3(0.02, 8.0, 8.0);
+  box.size = Vec3(0.02, extent, extent);
   box.at.position = Vec3(distance + 0.01, 0.0, 0.0);
   Colliders colliders;
   colliders.boxes.push_back(box);
-  World world = buildWorld(sceneWith(colliders));
+  return colliders;
+}
+
+/// The standard deviation [m] of a flat face's depth at `distance` straight ahead, and the image.
+std::pair<double, CameraImage> spread(double distance, std::uint64_t seed, std::uint64_t frame)
+{
+  World world = buildWorld(sceneWith(wallAhead(distance, 8.0)));
   CameraDef def = smallCamera();
   def.noise = DepthNoise{ 0.001, seed };
   DepthCamera camera(def, world.model());
@@ -237,13 +243,7 @@ TEST(DepthCamera, NothingNearerThanMinRangeOrFartherThanMaxRangeReturnsADepthTho
 {
   for (const double distance : { 0.05, 15.0 })
   {
-    Box box;
-    box.at.name = "wall";
-    box.size = Vec3(0.02, 100.0, 100.0);
-    box.at.position = Vec3(distance + 0.01, 0.0, 0.0);
-    Colliders colliders;
-    colliders.boxes.push_back(box);
-    World world = buildWorld(sceneWith(colliders));
+    World world = buildWorld(sceneWith(wallAhead(distance, 100.0)));
     DepthCamera camera(smallCamera(), world.model());  // 0.1 to 10 m
     const CameraImage image = camera.render(world.state(), world.colliderPoses(), RigidPose{}, 0);
     EXPECT_TRUE(std::isnan(image.depth[at(image, 80, 60)])) << distance;

@@ -43,16 +43,6 @@ public:
     glide(t, t, position, orientation, max_interval, 1.0);
   }
 
-  /// The pose is known exactly at time t (a tf frame's transform interpolated there): it is there, at
-  /// rest, and counts as an input stamped t for the speed of the next.
-  void place(double t, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation)
-  {
-    from_ = to_ = position;
-    from_orientation_ = to_orientation_ = orientation;
-    from_time_ = to_time_ = last_stamp_ = t;
-    started_ = true;
-  }
-
   /// A holder on a tf frame, in a step ending at `end` [s] where tf has the frame on both sides (published
   /// ahead): it takes tf's pose there if it is on the frame (it was in the last step, it has not started,
   /// or its glide ended right there, the frame at rest), and says so. Otherwise it keeps gliding
@@ -107,6 +97,16 @@ public:
   bool movingAfter(double t) const { return started_ && t < to_time_; }
 
 private:
+  /// The pose is known exactly at time t (a tf frame's transform interpolated there): it is there, at
+  /// rest, and counts as an input stamped t for the speed of the next.
+  void place(double t, const Vec3& position, const std::optional<Eigen::Quaterniond>& orientation)
+  {
+    from_ = to_ = position;
+    from_orientation_ = to_orientation_ = orientation;
+    from_time_ = to_time_ = last_stamp_ = t;
+    started_ = true;
+  }
+
   bool isLastInput(const Vec3& position, const Eigen::Quaterniond& orientation) const
   {
     return to_ == position && to_orientation_ && to_orientation_->coeffs() == orientation.coeffs();
