@@ -32,6 +32,9 @@
 // surface_samples cost per step against its nodes alone (which let the rod in).
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
+// BM_CameraFrame/<render|messages>: a 640 x 480 frame of config/scenes/demo.yaml's camera 2 s into the
+// scene (sensing/depth_camera.h): the ray casting alone, and with the node's five messages made from it
+// (colour, depth in millimetres and in metres, mask, organised cloud: RosConverter); items = pixels.
 #include <cmath>
 
 #include <benchmark/benchmark.h>
@@ -43,6 +46,9 @@
 #include "soft_body_sim/core/meshing/volume_mesh.h"
 #include "soft_body_sim/core/elements/forces.h"
 #include "soft_body_sim/core/elements/tetrahedra.h"
+#include "soft_body_sim/core/sensing/depth_camera.h"
+#include "soft_body_sim/ros/ros_converter.h"
+#include "soft_body_sim/scene/scene_loader.h"
 #include "core/integrators/integrator_kit.h"
 #include "large_cloth.h"
 #include "test_meshes.h"
@@ -642,6 +648,38 @@ void BM_ClothOnColliders(benchmark::State& bench, bool faces)
   stepFirstMoments(bench, scene, 60);
 }
 
+/// The demo's camera on the demo scene 2 s in (its bodies settled, the jelly landed).
+void BM_CameraFrame(benchmark::State& bench, bool messages)
+{
+  const SceneDef scene = loadSceneFile(SOURCE_DIR "/config/scenes/demo.yaml");
+  World world = buildWorld(scene);
+  while (world.time() < 2.0)
+    world.step();
+  const CameraDef& def = scene.cameras.at(0);
+  DepthCamera camera(def, world.model());
+  const RigidPose link{ def.position, def.orientation.normalized() };
+  const std::vector<ColliderPose> colliders = world.colliderPoses();
+  std_msgs::Header header;
+  header.frame_id = def.name + "_color_optical_frame";
+  CameraImage image;
+  std::uint64_t frame = 0;
+  for (auto _ : bench)
+  {
+    camera.render(world.state(), colliders, link, frame++, image);
+    if (messages)
+    {
+      benchmark::DoNotOptimize(RosConverter::toCameraInfo(camera.intrinsics(), header));
+      benchmark::DoNotOptimize(RosConverter::toColorImage(image, header));
+      benchmark::DoNotOptimize(RosConverter::toDepthMillimetres(image, header));
+      benchmark::DoNotOptimize(RosConverter::toDepthMetres(image, header));
+      benchmark::DoNotOptimize(RosConverter::toMask(image, header));
+      benchmark::DoNotOptimize(RosConverter::toPointCloud(image, camera.intrinsics(), header));
+    }
+    benchmark::DoNotOptimize(image.depth.data());
+  }
+  bench.SetItemsProcessed(bench.iterations() * image.width * image.height);
+}
+
 /// Node counts from 100 to 100,000, two per decade.
 void clothSizes(benchmark::internal::Benchmark* bench)
 {
@@ -692,6 +730,8 @@ BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_2mm, 0.002)->Unit(benchmark::kMill
 BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_1mm, 0.001)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
+BENCHMARK_CAPTURE(BM_CameraFrame, render, false)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_CameraFrame, messages, true)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace soft_body_sim

@@ -69,7 +69,8 @@ void CameraPublisher::run()
       job = std::move(*pending_);
       pending_.reset();
     }
-    publish(camera_.render(job.state, job.colliders, job.link, job.frame), job.stamp);
+    camera_.render(job.state, job.colliders, job.link, job.frame, image_);
+    publish(image_, job.stamp);
   }
 }
 

@@ -227,6 +227,7 @@ struct Photographer
 {
   const CameraDef* def = nullptr;
   std::unique_ptr<DepthCamera> camera;
+  CameraImage image;  ///< its buffers reused frame after frame
   std::uint64_t frame = 0;
 
   /// Writes every frame due by the world's time: frame n at n / rate.
@@ -235,7 +236,8 @@ struct Photographer
     while (static_cast<double>(frame) / def->rate <= world.time() + 1e-9 / def->rate)
     {
       const RigidPose link{ def->position, def->orientation.normalized() };
-      writeCameraImages(directory, def->name, frame, camera->render(world.state(), world.colliderPoses(), link, frame));
+      camera->render(world.state(), world.colliderPoses(), link, frame, image);
+      writeCameraImages(directory, def->name, frame, image);
       ++frame;
     }
   }
@@ -248,7 +250,7 @@ std::vector<Photographer> photographers(const SceneDef& scene, const World& worl
   std::vector<Photographer> all;
   for (const CameraDef& camera : scene.cameras)
     if (camera.frame.empty())
-      all.push_back({ &camera, std::make_unique<DepthCamera>(camera, world.model()), 0 });
+      all.push_back({ &camera, std::make_unique<DepthCamera>(camera, world.model()), CameraImage{}, 0 });
     else
       err << "simulate: note: camera '" << camera.name << "' rides on tf frame '" << camera.frame
           << "': without tf it takes no pictures\n";

@@ -64,6 +64,7 @@ private:
 
   CameraDef def_;
   DepthCamera camera_;
+  CameraImage image_;  ///< the render thread's frame, its buffers reused
   std::uint64_t frame_ = 0;  ///< the next frame's number
   image_transport::ImageTransport transport_;
   image_transport::CameraPublisher color_, aligned_depth_;

@@ -26,11 +26,25 @@ constexpr double kPlaneReach = 10.0;
 constexpr unsigned kBoxTriangles[12][3] = { { 0, 2, 3 }, { 0, 3, 1 }, { 4, 5, 7 }, { 4, 7, 6 }, { 0, 1, 5 }, { 0, 5, 4 },
                                             { 2, 6, 7 }, { 2, 7, 3 }, { 0, 4, 6 }, { 0, 6, 2 }, { 1, 3, 7 }, { 1, 7, 5 } };
 
+/// Rays go out this many at a time along a row (Embree's packets: neighbouring pixels' rays meet the same
+/// parts of the hierarchy, which it then walks once for all of them; 16 fill an AVX-512 register).
+constexpr int kLanes = 16;
+
 /// Who a geometry belongs to: its mask value and its colour.
 struct Owner
 {
   std::uint16_t mask = 0;
-  Eigen::Vector3d color = Eigen::Vector3d::Zero();
+  Eigen::Vector3f color = Eigen::Vector3f::Zero();
+};
+
+/// A geometry attached to one of the camera's two Embree scenes (ids unique across both).
+struct Geometry
+{
+  RTCGeometry handle = nullptr;
+  Owner owner;
+  bool round = false;       ///< curves or points (in `rounds`), else triangles (in `surfaces`)
+  std::size_t vertices = 0;
+  bool enabled = true;      ///< a collider not yet placed is disabled
 };
 
 Eigen::Vector3f relative(const Vec3& point, const Vec3& eye) { return (point - eye).cast<float>(); }
@@ -61,7 +75,6 @@ struct DepthCamera::Scene
     ColliderPose shape;
     std::shared_ptr<const TriangleMesh> mesh;
     unsigned geometry = RTC_INVALID_GEOMETRY_ID;
-    bool enabled = true;
   };
   struct PlaneGeometry
   {
@@ -72,8 +85,14 @@ struct DepthCamera::Scene
   CameraDef def;
   CameraIntrinsics intrinsics;
   RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  std::vector<Owner> owners;  ///< by geometry id
+  // Triangles and round geometry (curves, points) in scenes of their own: Embree walks round geometry's
+  // hierarchy one ray at a time even in a packet, at 20 ns a ray (measured), so only the packets whose
+  // pixels can see some of it (roundPackets) look into `rounds`, after `surfaces`.
+  RTCScene surfaces = nullptr;
+  RTCScene rounds = nullptr;
+  std::vector<Geometry> geometries;  ///< by id
+  /// Per packet of kLanes pixels of a row (row-major): whether any round geometry's box projects onto it.
+  std::vector<std::uint8_t> round_packets;
   std::vector<Body> bodies;
   std::vector<Collider> colliders;
   std::vector<PlaneGeometry> planes;
@@ -81,13 +100,15 @@ struct DepthCamera::Scene
   Scene(const CameraDef& camera, const Model& model);
   ~Scene()
   {
-    if (scene)
-      rtcReleaseScene(scene);
+    for (const RTCScene scene : { surfaces, rounds })
+      if (scene)
+        rtcReleaseScene(scene);
     if (device)
       rtcReleaseDevice(device);
   }
 
-  /// A new geometry of `type` attached to the scene for `owner`, refitted rather than rebuilt; its id.
+  /// A new geometry of `type` attached for `owner` (triangles to `surfaces`, the rest to `rounds`),
+  /// refitted rather than rebuilt; its id.
   unsigned add(RTCGeometryType type, const Owner& owner, std::size_t vertices, RTCFormat vertex_format,
                std::size_t vertex_size, std::size_t primitives, RTCFormat index_format, std::size_t index_size)
   {
@@ -96,18 +117,18 @@ struct DepthCamera::Scene
     if (primitives > 0)
       rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_INDEX, 0, index_format, index_size, primitives);
     rtcSetGeometryBuildQuality(geometry, RTC_BUILD_QUALITY_REFIT);
-    const unsigned id = rtcAttachGeometry(scene, geometry);
-    rtcReleaseGeometry(geometry);
-    if (owners.size() <= id)
-      owners.resize(id + 1);
-    owners[id] = owner;
+    const bool round = type != RTC_GEOMETRY_TYPE_TRIANGLE;
+    const auto id = static_cast<unsigned>(geometries.size());
+    rtcAttachGeometryByID(round ? rounds : surfaces, geometry, id);
+    rtcReleaseGeometry(geometry);  // its scene holds it
+    geometries.push_back(Geometry{ geometry, owner, round, vertices });
     return id;
   }
   unsigned addTriangles(const Owner& owner, std::size_t vertices, const std::vector<std::array<unsigned, 3>>& triangles)
   {
     const unsigned id = add(RTC_GEOMETRY_TYPE_TRIANGLE, owner, vertices, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
                             triangles.size(), RTC_FORMAT_UINT3, 3 * sizeof(unsigned));
-    auto* index = static_cast<unsigned*>(rtcGetGeometryBufferData(rtcGetGeometry(scene, id), RTC_BUFFER_TYPE_INDEX, 0));
+    auto* index = static_cast<unsigned*>(rtcGetGeometryBufferData(geometries[id].handle, RTC_BUFFER_TYPE_INDEX, 0));
     for (const std::array<unsigned, 3>& t : triangles)
       for (const unsigned corner : t)
         *index++ = corner;
@@ -118,7 +139,7 @@ struct DepthCamera::Scene
   {
     const unsigned id = add(type, owner, 2 * segments, RTC_FORMAT_FLOAT4, 4 * sizeof(float), segments,
                             RTC_FORMAT_UINT, sizeof(unsigned));
-    auto* index = static_cast<unsigned*>(rtcGetGeometryBufferData(rtcGetGeometry(scene, id), RTC_BUFFER_TYPE_INDEX, 0));
+    auto* index = static_cast<unsigned*>(rtcGetGeometryBufferData(geometries[id].handle, RTC_BUFFER_TYPE_INDEX, 0));
     for (std::size_t k = 0; k < segments; ++k)
       index[k] = static_cast<unsigned>(2 * k);
     return id;
@@ -131,11 +152,11 @@ struct DepthCamera::Scene
 
   float* vertices(unsigned id) const
   {
-    return static_cast<float*>(rtcGetGeometryBufferData(rtcGetGeometry(scene, id), RTC_BUFFER_TYPE_VERTEX, 0));
+    return static_cast<float*>(rtcGetGeometryBufferData(geometries[id].handle, RTC_BUFFER_TYPE_VERTEX, 0));
   }
   void commit(unsigned id) const
   {
-    RTCGeometry geometry = rtcGetGeometry(scene, id);
+    RTCGeometry geometry = geometries[id].handle;
     rtcUpdateGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0);
     rtcCommitGeometry(geometry);
   }
@@ -143,6 +164,7 @@ struct DepthCamera::Scene
   void placeBodies(const State& state, const Vec3& eye) const;
   void placeColliders(const std::vector<ColliderPose>& poses, const Vec3& eye);
   void placePlanes(const Vec3& eye) const;
+  void markRoundPackets(const Eigen::Matrix3f& optical);
 };
 
 DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
@@ -151,15 +173,18 @@ DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
   device = rtcNewDevice(nullptr);
   if (!device)
     throw std::runtime_error("camera '" + camera.name + "': Embree could not start (rtcNewDevice failed)");
-  scene = rtcNewScene(device);
-  rtcSetSceneFlags(scene, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
-  rtcSetSceneBuildQuality(scene, RTC_BUILD_QUALITY_LOW);
+  for (RTCScene* scene : { &surfaces, &rounds })
+  {
+    *scene = rtcNewScene(device);
+    rtcSetSceneFlags(*scene, RTC_SCENE_FLAG_DYNAMIC | RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(*scene, RTC_BUILD_QUALITY_LOW);
+  }
 
   for (std::size_t b = 0; b < model.bodies.size(); ++b)
   {
     const BodyRange& range = model.bodies[b];
     const Look& look = range.look;
-    const Owner owner{ static_cast<std::uint16_t>(1 + b), look.color };
+    const Owner owner{ static_cast<std::uint16_t>(1 + b), look.color.cast<float>() };
     Body body;
     body.look = look;
     body.first = range.first;
@@ -186,11 +211,11 @@ DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
     if (!plane.name.empty())
       ++index;
     std::vector<std::array<unsigned, 3>> square = { { 0, 1, 2 }, { 0, 2, 3 } };
-    planes.push_back({ plane, addTriangles(Owner{ 0, plane.color }, 4, square) });
+    planes.push_back({ plane, addTriangles(Owner{ 0, plane.color.cast<float>() }, 4, square) });
   }
   const auto addShape = [&](const ColliderPose& shape, const std::shared_ptr<const TriangleMesh>& mesh) {
     Collider collider{ shape, mesh };
-    const Owner owner{ index++, shape.color };
+    const Owner owner{ index++, shape.color.cast<float>() };
     std::vector<std::array<unsigned, 3>> triangles;
     switch (shape.shape)
     {
@@ -277,17 +302,17 @@ void DepthCamera::Scene::placeColliders(const std::vector<ColliderPose>& poses, 
     for (const ColliderPose& p : poses)
       if (p.name == collider.shape.name)
         pose = &p;
-    RTCGeometry geometry = rtcGetGeometry(scene, collider.geometry);
+    Geometry& geometry = geometries[collider.geometry];
     if (!pose)
     {
-      if (collider.enabled)
-        rtcDisableGeometry(geometry);
-      collider.enabled = false;
+      if (geometry.enabled)
+        rtcDisableGeometry(geometry.handle);
+      geometry.enabled = false;
       continue;
     }
-    if (!collider.enabled)
-      rtcEnableGeometry(geometry);
-    collider.enabled = true;
+    if (!geometry.enabled)
+      rtcEnableGeometry(geometry.handle);
+    geometry.enabled = true;
     const Eigen::Quaterniond turn = pose->orientation.normalized();
     const auto local = [&](const Vec3& p) { return relative(pose->position + turn * p, eye); };
     float* v = vertices(collider.geometry);
@@ -342,6 +367,53 @@ void DepthCamera::Scene::placePlanes(const Vec3& eye) const
   }
 }
 
+void DepthCamera::Scene::markRoundPackets(const Eigen::Matrix3f& optical)
+{
+  const int columns = (intrinsics.width + kLanes - 1) / kLanes;
+  round_packets.assign(static_cast<std::size_t>(columns) * static_cast<std::size_t>(intrinsics.height), 0);
+  const auto mark = [&](int u0, int u1, int v0, int v1) {
+    for (int v = std::max(v0, 0); v <= std::min(v1, intrinsics.height - 1); ++v)
+      for (int c = std::max(u0, 0) / kLanes; c <= std::min(u1, intrinsics.width - 1) / kLanes; ++c)
+        round_packets[static_cast<std::size_t>(v) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(c)] = 1;
+  };
+  for (const Geometry& geometry : geometries)
+  {
+    if (!geometry.round || !geometry.enabled)
+      continue;
+    // Its box (every vertex's ball: x y z radius, relative to the camera), its eight corners in the
+    // optical frame and their pixels: the box's picture lies within theirs when all are in front.
+    const float* v = static_cast<const float*>(rtcGetGeometryBufferData(geometry.handle, RTC_BUFFER_TYPE_VERTEX, 0));
+    Eigen::AlignedBox3f box;
+    for (std::size_t k = 0; k < geometry.vertices; ++k)
+    {
+      const Eigen::Vector3f centre(v[4 * k], v[4 * k + 1], v[4 * k + 2]);
+      box.extend(centre - Eigen::Vector3f::Constant(v[4 * k + 3])).extend(centre + Eigen::Vector3f::Constant(v[4 * k + 3]));
+    }
+    int behind = 0;
+    Eigen::Vector2f low = Eigen::Vector2f::Constant(std::numeric_limits<float>::infinity()), high = -low;
+    for (int c = 0; c < 8; ++c)
+    {
+      const Eigen::Vector3f p = optical.transpose() * box.corner(static_cast<Eigen::AlignedBox3f::CornerType>(c));
+      if (p.z() <= 0.0f)
+      {
+        ++behind;
+        continue;
+      }
+      const Eigen::Vector2f pixel(static_cast<float>(intrinsics.fx) * p.x() / p.z() + static_cast<float>(intrinsics.cx),
+                                  static_cast<float>(intrinsics.fy) * p.y() / p.z() + static_cast<float>(intrinsics.cy));
+      low = low.cwiseMin(pixel);
+      high = high.cwiseMax(pixel);
+    }
+    if (behind == 8)
+      continue;
+    if (behind > 0)  // it reaches behind the camera: it may be anywhere in the picture
+      mark(0, intrinsics.width - 1, 0, intrinsics.height - 1);
+    else if (high.x() >= -1.0f && high.y() >= -1.0f && low.x() <= intrinsics.width && low.y() <= intrinsics.height)
+      mark(static_cast<int>(std::floor(low.x())) - 1, static_cast<int>(std::ceil(high.x())) + 1,
+           static_cast<int>(std::floor(low.y())) - 1, static_cast<int>(std::ceil(high.y())) + 1);
+  }
+}
+
 std::vector<std::uint16_t> depthMillimetres(const CameraImage& image)
 {
   std::vector<std::uint16_t> millimetres(image.depth.size(), 0);
@@ -367,34 +439,42 @@ const CameraIntrinsics& DepthCamera::intrinsics() const { return scene_->intrins
 CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
                                 std::uint64_t frame_number)
 {
+  CameraImage image;
+  render(state, colliders, link, frame_number, image);
+  return image;
+}
+
+void DepthCamera::render(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
+                         std::uint64_t frame_number, CameraImage& image)
+{
   Scene& s = *scene_;
   const Vec3 eye = link.position;
   s.placeBodies(state, eye);
   s.placeColliders(colliders, eye);
   s.placePlanes(eye);
-  rtcCommitScene(s.scene);
+  rtcCommitScene(s.surfaces);
+  rtcCommitScene(s.rounds);
 
   const CameraIntrinsics& k = s.intrinsics;
   const CameraDef& def = s.def;
-  CameraImage image;
   image.width = k.width;
   image.height = k.height;
   const std::size_t pixels = static_cast<std::size_t>(k.width) * static_cast<std::size_t>(k.height);
-  image.depth.assign(pixels, std::numeric_limits<float>::quiet_NaN());
-  image.color.assign(3 * pixels, 0);
-  image.mask.assign(pixels, 0);
+  image.depth.resize(pixels);  // every pixel is written below
+  image.color.resize(3 * pixels);
+  image.mask.resize(pixels);
   // The optical frame's axes in the scene frame: a pixel's ray (x, y, 1) in it has t = z along it.
   const Eigen::Matrix3f optical = (link.orientation.normalized() * linkToOptical()).toRotationMatrix().cast<float>();
+  s.markRoundPackets(optical);
+  const int columns = (k.width + kLanes - 1) / kLanes;
   std::mt19937_64 random(def.noise ? def.noise->seed ^ (0x9E3779B97F4A7C15ull * (frame_number + 1)) : 0);
   std::normal_distribution<double> unit_normal(0.0, 1.0);
-  // Rays go out eight at a time along a row (Embree's packets: neighbouring pixels' rays meet the same
-  // parts of the hierarchy, which it then walks once for all of them).
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
   // Rounded to the nearest of 0..255 (std::lround's call cost a fifth of the frame).
-  const auto channel = [](double value) { return static_cast<std::uint8_t>(255.0 * std::clamp(value, 0.0, 1.0) + 0.5); };
-  constexpr int kLanes = 8;
+  const auto channel = [](float value) { return static_cast<std::uint8_t>(255.0f * std::clamp(value, 0.0f, 1.0f) + 0.5f); };
+  const Eigen::Vector3f background = def.background.cast<float>();
   // A pixel's ray is linear in its column: the row's first ray plus u times the step between columns.
   const Eigen::Vector3f column_step = optical * Eigen::Vector3f(static_cast<float>(1.0 / k.fx), 0.0f, 0.0f);
   for (int v = 0; v < k.height; ++v)
@@ -403,8 +483,8 @@ CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPo
         optical * Eigen::Vector3f(static_cast<float>(-k.cx / k.fx), static_cast<float>((v - k.cy) / k.fy), 1.0f);
     for (int u0 = 0; u0 < k.width; u0 += kLanes)
     {
-      alignas(32) int valid[kLanes];
-      alignas(32) RTCRayHit8 rays;
+      alignas(64) int valid[kLanes];
+      alignas(64) RTCRayHit16 rays;
       Eigen::Vector3f directions[kLanes];
       for (int i = 0; i < kLanes; ++i)
       {
@@ -424,19 +504,24 @@ CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPo
         rays.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
         rays.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
       }
-      rtcIntersect8(valid, s.scene, &context, &rays);
+      rtcIntersect16(valid, s.surfaces, &context, &rays);
+      // Round geometry nearer than the surface hit (tfar is now its distance) replaces it.
+      if (s.round_packets[static_cast<std::size_t>(v) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(u0 / kLanes)])
+        rtcIntersect16(valid, s.rounds, &context, &rays);
       for (int i = 0; i < kLanes && u0 + i < k.width; ++i)
       {
         const std::size_t pixel =
             static_cast<std::size_t>(v) * static_cast<std::size_t>(k.width) + static_cast<std::size_t>(u0 + i);
-        Eigen::Vector3d color = def.background;
+        Eigen::Vector3f color = background;
+        image.mask[pixel] = 0;
+        image.depth[pixel] = std::numeric_limits<float>::quiet_NaN();
         if (rays.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID)
         {
-          const Owner& owner = s.owners[rays.hit.geomID[i]];
+          const Owner& owner = s.geometries[rays.hit.geomID[i]].owner;
           image.mask[pixel] = owner.mask;
           const Eigen::Vector3f normal(rays.hit.Ng_x[i], rays.hit.Ng_y[i], rays.hit.Ng_z[i]);
           const float norms = normal.norm() * directions[i].norm();
-          const double lambert = norms > 0.0f ? std::abs(normal.dot(directions[i])) / norms : 0.0;
+          const float lambert = norms > 0.0f ? std::abs(normal.dot(directions[i])) / norms : 0.0f;
           color = owner.color * lambert;
           const double z = rays.ray.tfar[i];
           if (z >= def.min_range && z <= def.max_range)
@@ -450,7 +535,6 @@ CameraImage DepthCamera::render(const State& state, const std::vector<ColliderPo
       }
     }
   }
-  return image;
 }
 
 }  // namespace soft_body_sim

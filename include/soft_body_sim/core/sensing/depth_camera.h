@@ -7,7 +7,9 @@
 // reaching 10 times max_range from the point below the camera. The geometry's topology is built once; each
 // frame moves its vertices and refits Embree's hierarchy rather than rebuilding it. Vertices are taken
 // relative to the camera before Embree's single precision: a scene far from its origin (a UTM map frame)
-// loses nothing.
+// loses nothing. Rays go out 16 at a time along a row; round geometry (tubes, balls, spheres, capsules,
+// cylinders), which Embree walks one ray at a time even in a packet, is in a scene of its own, looked into
+// only by the packets its boxes project onto.
 //
 // Per pixel: the nearest surface along the pixel's ray, its colour shaded by Lambert's law under a light at
 // the camera (rgb = colour |cos| of the angle between ray and surface, both sides lit), its body or
@@ -59,6 +61,11 @@ public:
   /// The frame seen from `link` (the pose of <name>_link in the scene frame) with the nodes at `state`'s
   /// positions and the placed colliders at `colliders` (World::colliderPoses; one not yet placed is not
   /// seen). `frame_number` draws the noise: the same number gives the same noise.
+  /// Into `image`, whose buffers are reused (a camera's frames are all one size: no allocation after the
+  /// first).
+  void render(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
+              std::uint64_t frame_number, CameraImage& image);
+  /// The same into a new image.
   CameraImage render(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
                      std::uint64_t frame_number);
 
