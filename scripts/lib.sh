@@ -22,6 +22,7 @@ PACKAGES=(
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libinteractive-markers-dev libdiagnostic-updater-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
   liburdf-dev ros-robot-state-publisher python3-sensor-msgs libsensor-msgs-dev libimage-transport-dev
+  libdepth-image-proc-dev
   rosbash python3-rospy python3-rosbag python3-rosservice python3-tf2-ros python3-std-srvs python3-geometry-msgs
   python3-visualization-msgs python3-diagnostic-msgs python3-rosgraph-msgs
   rviz xvfb libgl1-mesa-dri python3-pil

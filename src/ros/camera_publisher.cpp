@@ -41,17 +41,26 @@ std::uint64_t CameraPublisher::dropped() const
   return dropped_;
 }
 
-void CameraPublisher::shoot(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
-                            const ros::Time& stamp, double t)
+std::optional<std::uint64_t> CameraPublisher::due(double t)
 {
-  // The frame due now; any due before it (a long tick) are skipped.
+  if (t + 1e-9 / def_.rate < static_cast<double>(frame_) / def_.rate)
+    return std::nullopt;
+  // The frame due now; any due before it (a step longer than a frame's period) are skipped.
   const std::uint64_t frame = static_cast<std::uint64_t>(std::floor(t * def_.rate + 1e-9));
   const std::uint64_t skipped = frame - std::min(frame, frame_);
   frame_ = frame + 1;
-  std::lock_guard<std::mutex> lock(mutex_);
   if (!watched())
-    return;
-  dropped_ += skipped + (pending_ ? 1 : 0);
+    return std::nullopt;
+  std::lock_guard<std::mutex> lock(mutex_);
+  dropped_ += skipped;
+  return frame;
+}
+
+void CameraPublisher::shoot(std::uint64_t frame, const State& state, const std::vector<ColliderPose>& colliders,
+                            const RigidPose& link, const ros::Time& stamp)
+{
+  std::lock_guard<std::mutex> lock(mutex_);
+  dropped_ += pending_ ? 1 : 0;
   pending_ = Job{ state, colliders, link, stamp, frame };
   wake_.notify_one();
 }

@@ -163,23 +163,28 @@ void SimNode::addCameras()
   camera_frames_->sendTransform(frames);
 }
 
-void SimNode::shootCameras(const ros::Time& stamp)
+void SimNode::shootCameras()
 {
   const double t = world_->time();
+  const ros::Time stamp = rosTime(t);
   for (const std::unique_ptr<CameraPublisher>& camera : cameras_)
   {
-    if (!camera->due(t))
+    const std::optional<std::uint64_t> frame = camera->due(t);
+    if (!frame)
       continue;
+    const State& state = world_->state();
+    if (!state.position.allFinite())
+      continue;  // publish() says so
     const CameraDef& def = camera->def();
     RigidPose link{ def.position, def.orientation.normalized() };
     if (!def.frame.empty())
     {
-      const std::optional<RigidPose> frame = framePose(def.frame, stamp);  // warns (throttled) if there is none
-      if (!frame)
+      const std::optional<RigidPose> pose = framePose(def.frame, stamp);  // warns (throttled) if there is none
+      if (!pose)
         continue;
-      link = compose(*frame, link);
+      link = compose(*pose, link);
     }
-    camera->shoot(world_->state(), world_->colliderPoses(), link, stamp, t);
+    camera->shoot(*frame, state, world_->colliderPoses(), link, stamp);
   }
 }
 
@@ -250,12 +255,16 @@ void SimNode::advance(const ros::Time& now, double elapsed)
   const auto start = std::chrono::steady_clock::now();
   const auto deadline = start + std::chrono::duration<double>(tick_budget_);
   long taken = 0;
+  // Cameras take their frames between steps, at the first step's end at or past each frame's instant
+  // (exactly at n / rate when dt divides the period), whatever the ticks' timing; and at t = 0.
+  shootCameras();
   for (; taken < steps; ++taken)
   {
     if (taken > 0 && std::chrono::steady_clock::now() > deadline)
       break;
     applyDueInputs(rosTime(world_->time() + dt));
     world_->step();
+    shootCameras();
   }
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (taken > 0)
@@ -302,7 +311,6 @@ void SimNode::publish()
                        name_.c_str());
     return;
   }
-  shootCameras(stamp);
   const std::vector<Holder> holders = RosConverter::holders(*world_);
   markers_publisher_.publish(RosConverter::toMarkers(*world_, scene_.frame_id, stamp));
   force_markers_publisher_.publish(RosConverter::toForceMarkers(holders, force_scale_, scene_.frame_id, stamp));

@@ -3,7 +3,12 @@
 along +x, 64 x 48 px over 60 degrees, at a wall whose face is 1.9 m away, with a red rope of radius 2 cm
 across its view 1 m away. Every topic of a frame carries the same stamp; the CameraInfo is the pinhole
 model; the wall's depth is 1.9 m at every pixel off the rope (z of a plane facing the camera); the rope
-owns its rows with its own depth; the cloud is the depth back-projected; tf places the optical frame."""
+owns its rows with its own depth; the cloud is the depth back-projected; tf places the optical frame.
+A second camera, 30 cm above the tf frame `wrist`, which this test moves to and fro along x (stamped ahead,
+so that tf knows it at every instant): each of its frames sees the wall from the frame's pose at the frame's
+stamp. depth_image_proc's point_cloud_xyzrgb nodelet, fed with that camera's colour image, registered
+depth (16UC1) and CameraInfo through an exact-time synchroniser, makes from every frame the cloud we
+publish, within 1 mm (the millimetres' rounding)."""
 import math
 import struct
 import threading
@@ -14,9 +19,11 @@ import tf2_ros
 from sensor_msgs.msg import CameraInfo, Image, PointCloud2
 from sensor_msgs import point_cloud2
 
-from node_client import NodeTestCase, wait_for
+from node_client import FrameBroadcaster, NodeTestCase, wait_for
 
 NODE = "/soft_body_sim/camera"
+WRIST = "/soft_body_sim/wrist"
+CONSUMER = "/point_cloud_xyzrgb/points"  # depth_image_proc's cloud of the wrist camera (camera.test)
 WIDTH, HEIGHT = 64, 48
 FX = 32.0 / math.tan(math.radians(30.0))
 CX, CY = 31.5, 23.5
@@ -41,6 +48,30 @@ class CameraTest(NodeTestCase):
             rospy.Subscriber(NODE + topic, message_type, cls.keep(kind), queue_size=20)
         cls.tf = tf2_ros.Buffer()
         cls.listener = tf2_ros.TransformListener(cls.tf)
+        # The wrist frame: 1 m up, to and fro along x between 0.1 and 0.5 m, a period of 12.6 s.
+        cls.start = rospy.Time.now().to_sec()
+        cls.wrist = FrameBroadcaster(period=0.01, lead=0.2)
+        cls.wrist.set("wrist", lambda t: ((cls.wrist_x(t), 0.0, 1.0), (0.0, 0.0, 0.0, 1.0)))
+        cls.wrist_depths = {}  # stamp -> Image (32FC1)
+        cls.clouds = {"ours": {}, "consumer": {}}  # stamp -> PointCloud2
+        rospy.Subscriber(WRIST + "/depth/image_rect", Image, cls.keep_in(cls.wrist_depths), queue_size=20)
+        rospy.Subscriber(WRIST + "/depth/points", PointCloud2, cls.keep_in(cls.clouds["ours"]), queue_size=20)
+        rospy.Subscriber(CONSUMER, PointCloud2, cls.keep_in(cls.clouds["consumer"]), queue_size=20)
+
+    @classmethod
+    def wrist_x(cls, t):
+        return 0.3 + 0.2 * math.sin(0.5 * (t - cls.start))
+
+    @classmethod
+    def keep_in(cls, messages):
+        def keep_message(message):
+            with cls.lock:
+                messages[message.header.stamp.to_nsec()] = message
+        return keep_message
+
+    def count(self, messages):
+        with self.lock:
+            return len(messages)
 
     @classmethod
     def keep(cls, kind):
@@ -119,6 +150,51 @@ class CameraTest(NodeTestCase):
         for axis, expected in (((0, 0, 1), (1, 0, 0)), ((1, 0, 0), (0, -1, 0)), ((0, 1, 0), (0, 0, -1))):
             for got, want in zip(rotate(q, axis), expected):
                 self.assertAlmostEqual(got, want, places=9)
+
+    def test_a_camera_on_a_moving_frame_sees_from_the_frames_pose_at_each_frames_stamp(self):
+        # The wall's face is 1.9 m along x; the camera looks along x from x(stamp): every pixel of its upper
+        # rows (the wall, above the rope's 30 cm lower line of sight) has depth 1.9 - x(stamp).
+        self.assertTrue(wait_for(lambda: self.count(self.wrist_depths) >= 25, 30.0))
+        with self.lock:
+            frames = sorted(self.wrist_depths.items())
+        expected = [1.9 - self.wrist_x(stamp * 1e-9) for stamp, _ in frames]
+        self.assertGreater(max(expected) - min(expected), 0.1)  # it moved between the frames
+        for (stamp, image), want in zip(frames, expected):
+            depth = struct.unpack("<%df" % (WIDTH * HEIGHT), bytes(image.data))
+            self.assertEqual(image.header.frame_id, "wrist_color_optical_frame")
+            for k in range(12 * WIDTH):  # rows 0 to 11
+                self.assertAlmostEqual(depth[k], want, delta=1e-4, msg=(stamp, k))
+
+    def test_depth_image_procs_cloud_of_each_frame_equals_ours(self):
+        # From the first cloud both we and the consumer have (it subscribes to the camera when we subscribe to
+        # it), the consumer's clouds have our clouds' stamps, every one: its exact-time synchroniser matched
+        # each frame's colour, depth and CameraInfo.
+        self.assertTrue(wait_for(lambda: self.count(self.clouds["consumer"]) >= 1, 30.0), "no consumer cloud")
+        self.assertTrue(wait_for(lambda: self.count(self.clouds["ours"]) >= 1, 30.0), "no cloud")
+        with self.lock:
+            first = max(min(self.clouds["consumer"]), min(self.clouds["ours"]))
+        self.assertTrue(wait_for(lambda: len([s for s in self.clouds["ours"] if s >= first]) >= 20, 30.0))
+        with self.lock:
+            ours = {s: c for s, c in self.clouds["ours"].items() if s >= first}
+        last = max(ours)
+        self.assertTrue(wait_for(lambda: last in self.clouds["consumer"], 5.0), "the last frame's cloud")
+        with self.lock:
+            consumer = dict(self.clouds["consumer"])
+        self.assertEqual(sorted(ours), sorted(s for s in consumer if first <= s <= last))
+        fields = ("x", "y", "z", "rgb")
+        for stamp in sorted(ours):
+            theirs = consumer[stamp]
+            self.assertEqual((theirs.height, theirs.width), (HEIGHT, WIDTH))
+            self.assertEqual(theirs.header.frame_id, "wrist_color_optical_frame")
+            mine = list(point_cloud2.read_points(ours[stamp], field_names=fields))
+            for k, point in enumerate(point_cloud2.read_points(theirs, field_names=fields)):
+                for axis in range(3):
+                    a, b = mine[k][axis], point[axis]
+                    if math.isnan(a) or math.isnan(b):
+                        self.assertTrue(math.isnan(a) and math.isnan(b), (stamp, k, axis, a, b))
+                    else:
+                        self.assertAlmostEqual(a, b, delta=1e-3, msg=(stamp, k, axis))
+                self.assertEqual(struct.pack("<f", mine[k][3])[:3], struct.pack("<f", point[3])[:3], (stamp, k))
 
 
 def rotate(q, v):

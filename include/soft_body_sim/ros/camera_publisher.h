@@ -35,13 +35,14 @@ public:
   CameraPublisher& operator=(const CameraPublisher&) = delete;
 
   const CameraDef& def() const { return def_; }
-  /// True if a frame is due at simulated time t [s]: frame n at n / rate, from t = 0.
-  bool due(double t) const { return t + 1e-9 / def_.rate >= static_cast<double>(frame_) / def_.rate; }
-  /// Takes the frame due at simulated time t [s], stamped `stamp`: the nodes at `state`, the colliders at
-  /// `colliders`, the camera's link at `link` in the scene frame. Frames due before t are skipped, and so
-  /// is this one if nobody listens.
-  void shoot(const State& state, const std::vector<ColliderPose>& colliders, const RigidPose& link,
-             const ros::Time& stamp, double t);
+  /// The number of the frame due at simulated time t [s] (frame n at n / rate, from t = 0) if one is due
+  /// and anyone listens to any of the camera's topics; it is then taken (shoot). Frames due before it are
+  /// skipped.
+  std::optional<std::uint64_t> due(double t);
+  /// Hands frame `frame` (due) to the render thread, stamped `stamp`: the nodes at `state`, the colliders
+  /// at `colliders`, the camera's link at `link` in the scene frame.
+  void shoot(std::uint64_t frame, const State& state, const std::vector<ColliderPose>& colliders,
+             const RigidPose& link, const ros::Time& stamp);
   /// Frames someone listened for that were skipped, since the start: the render thread was busy (a frame
   /// still waiting replaced by the next) or a tick took more than a frame's period.
   std::uint64_t dropped() const;

@@ -120,8 +120,8 @@ private:
   /// The scene's cameras: their publishers and their static tf frames (<name>_link under the scene frame
   /// or their `frame`, <name>_color_optical_frame under it).
   void addCameras();
-  /// Each camera whose frame is due at the world's time takes it, stamped `stamp`.
-  void shootCameras(const ros::Time& stamp);
+  /// Each camera with a frame due at the world's time and someone listening takes it, stamped with that instant.
+  void shootCameras();
   bool onAttach(Attach::Request& request, Attach::Response& response);
   bool onDetach(Detach::Request& request, Detach::Response& response);
   bool onGrasp(Grasp::Request& request, Grasp::Response& response);
