@@ -170,7 +170,9 @@ struct DepthCamera::Scene
 DepthCamera::Scene::Scene(const CameraDef& camera, const Model& model)
   : def(camera), intrinsics(CameraIntrinsics::of(camera))
 {
-  device = rtcNewDevice(nullptr);
+  // One thread: the refit costs 0.1 ms a frame, and Embree's default thread pool (TBB) would keep workers
+  // spinning beside the physics step after every frame's commit.
+  device = rtcNewDevice("threads=1");
   if (!device)
     throw std::runtime_error("camera '" + camera.name + "': Embree could not start (rtcNewDevice failed)");
   for (RTCScene* scene : { &surfaces, &rounds })
