@@ -32,6 +32,9 @@
 // surface_samples cost per step against its nodes alone (which let the rod in).
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
+// BM_Snapshot/<rope_51|demo>/<step|snapshot_restore>: a 51-node rope (implicit_euler at 1/60 s, gravity)
+// and config/scenes/demo.yaml 2 s in: one step against one World::snapshot (into the last snapshot's
+// buffers) plus World::restore.
 // BM_CameraFrame/<render|messages>: a 640 x 480 frame of config/scenes/demo.yaml's camera 2 s into the
 // scene (sensing/depth_camera.h): the ray casting alone, and with the node's five messages made from it
 // (colour, depth in millimetres and in metres, mask, organised cloud: RosConverter); items = pixels.
@@ -273,7 +276,6 @@ void BM_ThinRodPressing(benchmark::State& bench, double spacing)
   SceneDef scene;
   scene.physics.integrator = IntegratorType::ImplicitEuler;
   scene.physics.step = StepSettings{ 1.0 / 60.0, 4, 1 };
-  scene.physics.gravity = Vec3(0.0, 0.0, -9.81);
   scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
   VolumeDef box;
   box.size = Vec3(0.08, 0.08, 0.08);
@@ -297,7 +299,6 @@ void BM_SoftStack(benchmark::State& bench, bool touching)
   SceneDef scene;
   scene.physics.integrator = IntegratorType::ImplicitEuler;
   scene.physics.step = StepSettings{ 1.0 / 60.0, 1, 1 };
-  scene.physics.gravity = Vec3(0.0, 0.0, -9.81);
   scene.physics.drag = 5.0;
   scene.colliders.planes.push_back(Plane{ Vec3::Zero(), Vec3::UnitZ(), 0.0, 0.5 });
   VolumeDef cube;
@@ -648,6 +649,48 @@ void BM_ClothOnColliders(benchmark::State& bench, bool faces)
   stepFirstMoments(bench, scene, 60);
 }
 
+/// The world of BM_Snapshot: a 51-node rope (0.1 kg, 1000 N/m per segment) hanging from one end, implicit
+/// Euler at 1/60 s under gravity, or the demo scene 2 s in.
+World snapshotWorld(bool demo)
+{
+  if (demo)
+  {
+    World world = buildWorld(loadSceneFile(SOURCE_DIR "/config/scenes/demo.yaml"));
+    while (world.time() < 2.0)
+      world.step();
+    return world;
+  }
+  SceneDef scene = ropeScene(51, IntegratorType::ImplicitEuler);
+  scene.physics.step.dt = 1.0 / 60.0;
+  World world = buildWorld(scene);
+  for (int n = 0; n < 60; ++n)
+    world.step();
+  return world;
+}
+
+void BM_Snapshot(benchmark::State& bench, bool demo, bool snapshot_restore)
+{
+  World world = snapshotWorld(demo);
+  const WorldSnapshot moment = world.snapshot();
+  WorldSnapshot now = world.snapshot();
+  for (auto _ : bench)
+  {
+    if (snapshot_restore)
+    {
+      world.snapshot(now);  // as a planner takes one each cycle, into the last one's buffers
+      world.restore(now);
+    }
+    else
+    {
+      world.step();
+      bench.PauseTiming();
+      world.restore(moment);  // every timed step from the same moment
+      bench.ResumeTiming();
+    }
+    benchmark::DoNotOptimize(world.state().position.data());
+  }
+}
+
 /// The demo's camera on the demo scene 2 s in (its bodies settled, the jelly landed).
 void BM_CameraFrame(benchmark::State& bench, bool messages)
 {
@@ -730,6 +773,10 @@ BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_2mm, 0.002)->Unit(benchmark::kMill
 BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_1mm, 0.001)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
+BENCHMARK_CAPTURE(BM_Snapshot, rope_51/step, false, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, rope_51/snapshot_restore, false, true)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, demo/step, true, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, demo/snapshot_restore, true, true)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_CameraFrame, render, false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CameraFrame, messages, true)->Unit(benchmark::kMillisecond);
 

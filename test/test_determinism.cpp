@@ -162,32 +162,70 @@ std::vector<std::string> scenes()
   return paths;
 }
 
-/// The hash after kSteps steps (fewer for a large scene, see kNodeSteps) of `scene` with `integrator`:
-/// anchors circle (radius 5 cm, one turn in 2 s, from where they start) for the first half; every body
+/// The hash of the exact bits of every position and velocity.
+std::uint64_t hashOf(const World& world)
+{
+  return fnv1a(world.state().velocity, fnv1a(world.state().position, 14695981039346656037ULL));
+}
+
+/// A run of `scene` with `integrator`: kSteps steps (fewer for a large scene, see kNodeSteps) in which
+/// anchors circle (radius 5 cm, one turn in 2 s, from where they start) for the first half and every body
 /// that takes a target is sent 0.3 m along x at step 60.
+class Rollout
+{
+public:
+  Rollout(const SceneDef& scene, IntegratorType integrator) : world(build(scene, integrator))
+  {
+    steps = std::min(kSteps, static_cast<int>(kNodeSteps / world.model().nodeCount()));
+    for (const Anchor& anchor : world.model().anchors)
+      anchor_start.push_back(world.state().position.col(anchor.node));
+  }
+
+  /// Steps `w` (this run's world or a copy of it) from step `from` to step `to` with the run's inputs.
+  void stepInputs(World& w, int from, int to) const
+  {
+    for (int n = from; n < to; ++n)
+    {
+      if (n < steps / 2)
+        for (std::size_t k = 0; k < anchor_start.size(); ++k)
+        {
+          const double angle = M_PI * w.time();
+          w.moveAnchor(static_cast<int>(k), anchor_start[k] + 0.05 * Vec3(std::cos(angle) - 1.0, 0.0, std::sin(angle)));
+        }
+      if (n == 60)
+        for (const BodyRange& body : w.model().bodies)
+          w.setTarget(body.name, Vec3(w.state().position.col(body.first)) + Vec3(0.3, 0.0, 0.0));
+      w.step();
+    }
+  }
+
+  World world;
+  int steps = 0;
+  std::vector<Vec3> anchor_start;
+
+private:
+  static World build(SceneDef scene, IntegratorType integrator)
+  {
+    scene.physics.integrator = integrator;
+    return buildWorld(scene);
+  }
+};
+
+/// The hash after a whole run.
 std::uint64_t run(const SceneDef& scene, IntegratorType integrator)
 {
-  SceneDef with = scene;
-  with.physics.integrator = integrator;
-  World world = buildWorld(with);
-  const int steps = std::min(kSteps, static_cast<int>(kNodeSteps / world.model().nodeCount()));
-  std::vector<Vec3> anchor_start;
-  for (const Anchor& anchor : world.model().anchors)
-    anchor_start.push_back(world.state().position.col(anchor.node));
-  for (int n = 0; n < steps; ++n)
-  {
-    if (n < steps / 2)
-      for (std::size_t k = 0; k < anchor_start.size(); ++k)
-      {
-        const double angle = M_PI * world.time();
-        world.moveAnchor(static_cast<int>(k), anchor_start[k] + 0.05 * Vec3(std::cos(angle) - 1.0, 0.0, std::sin(angle)));
-      }
-    if (n == 60)
-      for (const BodyRange& body : world.model().bodies)
-        world.setTarget(body.name, Vec3(world.state().position.col(body.first)) + Vec3(0.3, 0.0, 0.0));
-    world.step();
-  }
-  return fnv1a(world.state().velocity, fnv1a(world.state().position, 14695981039346656037ULL));
+  Rollout rollout(scene, integrator);
+  rollout.stepInputs(rollout.world, 0, rollout.steps);
+  return hashOf(rollout.world);
+}
+
+/// The pinned hash of `path` with `integrator`, or nullptr.
+const Pinned* pinnedHash(const std::string& path, const std::string& integrator)
+{
+  const auto pinned = std::find_if(kPinned.begin(), kPinned.end(), [&](const Pinned& p) {
+    return path == p.scene && integrator == p.integrator;
+  });
+  return pinned == kPinned.end() ? nullptr : &*pinned;
 }
 
 TEST(Determinism, EveryExampleAndHardCaseSceneGivesItsPinnedBits)
@@ -206,10 +244,8 @@ TEST(Determinism, EveryExampleAndHardCaseSceneGivesItsPinnedBits)
         std::cout << "  { \"" << path << "\", \"" << name << "\", 0x" << std::hex << hash << std::dec << "ULL },\n";
         continue;
       }
-      const auto pinned = std::find_if(kPinned.begin(), kPinned.end(), [&](const Pinned& p) {
-        return path == p.scene && name == p.integrator;
-      });
-      ASSERT_NE(pinned, kPinned.end()) << path << " with " << name << " has no pinned hash";
+      const Pinned* pinned = pinnedHash(path, name);
+      ASSERT_NE(pinned, nullptr) << path << " with " << name << " has no pinned hash";
       EXPECT_EQ(hash, pinned->hash) << path << " with " << name;
       ++checked;
     }
@@ -218,6 +254,61 @@ TEST(Determinism, EveryExampleAndHardCaseSceneGivesItsPinnedBits)
   {
     EXPECT_EQ(checked, kPinned.size()) << "a pinned scene or integrator no longer runs";
   }
+}
+
+TEST(Determinism, AWorldClonedOrRestoredMidRunStepsOnToTheSameBits)
+{
+  // Every run of the first test, interrupted a third of the way (after the anchors began circling, before
+  // the targets jump): a clone (World's copy) stepped on with the same inputs, and the world itself stepped
+  // on, restored to a snapshot of that moment and stepped on again, each end on the run's pinned bits.
+  std::size_t checked = 0;
+  for (const std::string& path : scenes())
+  {
+    const SceneDef scene = loadSceneFile(std::string(SOURCE_DIR) + "/" + path);
+    for (const IntegratorType integrator : stableIntegrators(scene))
+    {
+      const std::string name = integratorName(integrator);
+      const Pinned* pinned = pinnedHash(path, name);
+      ASSERT_NE(pinned, nullptr) << path << " with " << name << " has no pinned hash";
+      Rollout rollout(scene, integrator);
+      const int split = rollout.steps / 3;
+      rollout.stepInputs(rollout.world, 0, split);
+      World clone(rollout.world);
+      const WorldSnapshot moment = rollout.world.snapshot();
+      rollout.stepInputs(rollout.world, split, rollout.steps);
+      EXPECT_EQ(hashOf(rollout.world), pinned->hash) << path << " with " << name;
+      rollout.stepInputs(clone, split, rollout.steps);
+      EXPECT_EQ(hashOf(clone), pinned->hash) << path << " with " << name << ": the clone";
+      rollout.world.restore(moment);
+      EXPECT_EQ(rollout.world.stepCount(), split);
+      rollout.stepInputs(rollout.world, split, rollout.steps);
+      EXPECT_EQ(hashOf(rollout.world), pinned->hash) << path << " with " << name << ": restored";
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, kPinned.size());
+}
+
+TEST(Determinism, ASnapshotOfAnotherSceneIsRefusedNamingBoth)
+{
+  World rope = buildWorld(loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/rope.yaml"));
+  World cloth = buildWorld(loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/cloth.yaml"));
+  const WorldSnapshot moment = cloth.snapshot();
+  rope.step();
+  const State before = rope.state();
+  try
+  {
+    rope.restore(moment);
+    FAIL() << "restored a cloth's snapshot into a rope";
+  }
+  catch (const std::invalid_argument& e)
+  {
+    const std::string message = e.what();
+    EXPECT_NE(message.find("cloth ("), std::string::npos) << message;
+    EXPECT_NE(message.find("rope ("), std::string::npos) << message;
+  }
+  EXPECT_EQ(rope.state().position, before.position);  // untouched
+  EXPECT_EQ(rope.stepCount(), 1);
 }
 
 }  // namespace

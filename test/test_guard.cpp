@@ -158,6 +158,7 @@ TEST(Guard, HalveStepFreezesABodyThatDivergesAtEveryStep)
 class RunawayController final : public Controller
 {
 public:
+  std::unique_ptr<Controller> clone() const override { return std::make_unique<RunawayController>(*this); }
   explicit RunawayController(int node) : node_(node) {}
   void step(double dt, State& state) override
   {

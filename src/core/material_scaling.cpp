@@ -9,11 +9,13 @@ namespace soft_body_sim
 {
 MaterialScaling::MaterialScaling(const Model& built) : scaling_(built.bodies.size()), has_material_(built.bodies.size(), 0)
 {
+  auto elements = std::make_shared<Model>();
   forEachKind([&](auto kind) {
-    kind.of(built_) = kind.of(built);
+    kind.of(*elements) = kind.of(built);
     for (const auto& element : kind.of(built))
       has_material_[built.bodyOf(kind.bodyNode(element))] = 1;
   });
+  built_ = std::move(elements);
 }
 
 void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& scaling)
@@ -27,7 +29,7 @@ void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& sca
   // From the built values, not the current ones: factors do not compound and 1 restores the scene.
   forEachKind([&](auto kind) {
     auto& live = kind.of(model);
-    const auto& built = kind.of(built_);
+    const auto& built = kind.of(*built_);
     for (std::size_t k = 0; k < live.size(); ++k)
       if (model.bodyOf(kind.bodyNode(built[k])) == body)
         kind.scale(live[k], built[k], scaling);

@@ -45,6 +45,85 @@ World::World(Model model, State initial, IntegratorType integrator, StepSettings
       throw std::invalid_argument("World: anchor '" + anchor.name + "' must name a pinned node");
 }
 
+World::World(const World& other)
+  : model_(other.model_)
+  , state_(other.state_)
+  , settings_(other.settings_)
+  , anchors_(other.anchors_)
+  , grasps_(other.grasps_)
+  , slips_(other.slips_)
+  , integrators_(other.integrators_)
+  , contacts_(other.contacts_)
+  , self_contacts_(other.self_contacts_)
+  , material_(other.material_)
+  , guard_(other.guard_)
+  , time_origin_(other.time_origin_)
+  , steps_origin_(other.steps_origin_)
+  , steps_(other.steps_)
+{
+  for (const BodyController& controller : other.controllers_)
+    controllers_.push_back(BodyController{ controller.body, controller.controller->clone() });
+}
+
+World& World::operator=(const World& other)
+{
+  if (this == &other)
+    return *this;
+  model_ = other.model_;
+  state_ = other.state_;
+  settings_ = other.settings_;
+  controllers_.clear();
+  for (const BodyController& controller : other.controllers_)
+    controllers_.push_back(BodyController{ controller.body, controller.controller->clone() });
+  anchors_ = other.anchors_;
+  grasps_ = other.grasps_;
+  slips_ = other.slips_;
+  integrators_ = other.integrators_;
+  contacts_ = other.contacts_;
+  self_contacts_ = other.self_contacts_;
+  material_ = other.material_;
+  guard_ = other.guard_;
+  time_origin_ = other.time_origin_;
+  steps_origin_ = other.steps_origin_;
+  steps_ = other.steps_;
+  return *this;
+}
+
+void World::snapshot(WorldSnapshot& into) const
+{
+  if (into.world_ && into.world_.use_count() == 1)
+    *into.world_ = *this;
+  else
+    into = snapshot();
+}
+
+double WorldSnapshot::time() const { return world_->time(); }
+
+std::int64_t WorldSnapshot::stepCount() const { return world_->stepCount(); }
+
+namespace
+{
+/// What a scene is made of, to tell two apart: its bodies (name and node count) and its element counts.
+std::string sceneSummary(const Model& model)
+{
+  std::string summary;
+  for (const BodyRange& body : model.bodies)
+    summary += (summary.empty() ? "" : ", ") + body.name + " (" + std::to_string(body.count) + " nodes)";
+  return summary + "; " + std::to_string(model.springs.size()) + " springs, " +
+         std::to_string(model.constraints.size()) + " constraints, " + std::to_string(model.rods.size()) +
+         " rods, " + std::to_string(model.tetrahedra.size()) + " tetrahedra";
+}
+}  // namespace
+
+void World::restore(const WorldSnapshot& snapshot)
+{
+  const std::string theirs = sceneSummary(snapshot.world_->model_), ours = sceneSummary(model_);
+  if (theirs != ours)
+    throw std::invalid_argument("World::restore: a snapshot of another scene (bodies " + theirs +
+                                ") cannot be restored into this one (bodies " + ours + ")");
+  *this = *snapshot.world_;
+}
+
 void World::step()
 {
   const double dt = settings_.dt;

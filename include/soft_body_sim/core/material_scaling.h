@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
@@ -33,7 +34,8 @@ public:
   bool has(std::size_t body) const { return has_material_.at(body) != 0; }
 
 private:
-  Model built_;  ///< the elements as built (its element arrays only)
+  /// The elements as built (its element arrays only); never changed, so copies of a world share it.
+  std::shared_ptr<const Model> built_;
   std::vector<BodyScaling> scaling_;  ///< per body
   std::vector<char> has_material_;    ///< per body
 };

@@ -34,12 +34,51 @@ struct BodyController
 /// Looks at the state between two stages of a step (World::observeIntegration).
 using StateObserver = std::function<void(const Model& model, const State& state)>;
 
+class World;
+
+/// A moment of a world (World::snapshot): everything its future depends on, to go back to it
+/// (World::restore). It shares nothing with the world it was taken from but the paths (see the copy).
+class WorldSnapshot
+{
+public:
+  /// [s] the world's simulated time then.
+  double time() const;
+  std::int64_t stepCount() const;
+
+private:
+  friend class World;
+  explicit WorldSnapshot(std::shared_ptr<World> world) : world_(std::move(world)) {}
+  std::shared_ptr<World> world_;  ///< never changed while shared (copies of a snapshot share it)
+};
+
 class World
 {
 public:
   /// @param model what the scene is; @param initial where it starts (3 x nodeCount arrays)
   World(Model model, State initial, IntegratorType integrator, StepSettings settings,
         std::vector<BodyController> controllers = {});
+  /// A clone: everything the future depends on is copied (the state, the time and step count, the anchors'
+  /// and grasps' goals and paths, the colliders' poses, goals and paths, the controllers' own state, the
+  /// guard's checkpoint and counts, each integrator's carried state, the self-contact lists), so that the
+  /// copy, given the same inputs, steps on to the same bits as the original. Paths (functions of time) are
+  /// shared: one that keeps state of its own (a ROS frame's glide) is not a pure input. The
+  /// integration observer is not copied.
+  World(const World& other);
+  World(World&&) = default;
+  World& operator=(World&&) = default;
+  /// As the copy, into this world's buffers (a world of the same scene allocates little); the integration
+  /// observer stays.
+  World& operator=(const World& other);
+
+  /// This moment, to come back to with restore.
+  WorldSnapshot snapshot() const { return WorldSnapshot(std::make_shared<World>(*this)); }
+  /// This moment into `into`, in its buffers if no copy of it shares them (a planner's snapshot taken again
+  /// each cycle allocates little).
+  void snapshot(WorldSnapshot& into) const;
+  /// Back to the moment `snapshot` took (of this world or of another of the same scene: the same bodies,
+  /// node counts and elements), as copy assignment. Throws std::invalid_argument, naming both scenes'
+  /// bodies, for a snapshot of another scene.
+  void restore(const WorldSnapshot& snapshot);
 
   /// Advances the simulation by settings().dt [s], as the named stages in world.cpp.
   void step();

@@ -56,6 +56,7 @@ SoftLength softLength(double relaxed, const CreatureDef& def)
 class CreatureController final : public Controller
 {
 public:
+  std::unique_ptr<Controller> clone() const override { return std::make_unique<CreatureController>(*this); }
   CreatureController(const CreatureDef& def, int first_node)
     : def_(def)
     , first_node_(first_node)

@@ -45,6 +45,7 @@ bool isArm(int root) { return root == kHumanoidLeftArm || root == kHumanoidRight
 class HumanoidController final : public Controller
 {
 public:
+  std::unique_ptr<Controller> clone() const override { return std::make_unique<HumanoidController>(*this); }
   HumanoidController(const HumanoidDef& def, const TorsoFrame& frame, int first_node)
     : def_(def)
     , frame_(frame)

@@ -23,6 +23,7 @@ Vec3 linkCorrection(const Vec3& a, const Vec3& b, double length, double tension)
 class LimbController final : public Controller
 {
 public:
+  std::unique_ptr<Controller> clone() const override { return std::make_unique<LimbController>(*this); }
   LimbController(const LimbDef& def, int first_node, const Vec3& joint, const Vec3& leaf)
     : first_node_(first_node)
     , samples_(def.motion.curve_samples)

@@ -31,6 +31,7 @@ bool collideWithPlanes(const std::vector<Plane>& planes, const Model& model, con
 class PlaneContacts final : public ColliderKind
 {
 public:
+  std::unique_ptr<ColliderKind> clone() const override { return std::make_unique<PlaneContacts>(*this); }
   /// Keeps the planes with unit normals; throws std::invalid_argument on a zero normal.
   PlaneContacts(std::vector<Plane> planes, int nodes);
 

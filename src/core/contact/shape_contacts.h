@@ -111,6 +111,7 @@ template <typename Shape>
 class ShapeContacts final : public ColliderKind
 {
 public:
+  std::unique_ptr<ColliderKind> clone() const override { return std::make_unique<ShapeContacts>(*this); }
   /// `faces`: the model has contact triangles (the shapes' features are made only then: a mesh's take a
   /// pass over its edges).
   ShapeContacts(std::vector<Shape> shapes, int nodes, bool faces)

@@ -17,6 +17,8 @@ template <bool kVelocityFirst>
 class Euler final : public ForceBasedIntegrator
 {
 public:
+  std::unique_ptr<Integrator> clone() const override { return std::make_unique<Euler>(*this); }
+  bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
   void step(const Model& model, State& state, double h, int iterations) override
   {
     computeAccelerations(model, state.position, state.velocity, force_, acceleration_);

@@ -11,6 +11,37 @@ IntegratorGroups::IntegratorGroups(IntegratorType scene_type, std::size_t bodies
 {
 }
 
+IntegratorGroups::IntegratorGroups(const IntegratorGroups& other)
+  : scene_type_(other.scene_type_), integrator_(other.integrator_->clone()), body_type_(other.body_type_),
+    dirty_(other.dirty_)
+{
+  for (const Group& group : other.groups_)
+    groups_.push_back(Group{ group.type, group.model, group.integrator->clone(), group.elements });
+}
+
+IntegratorGroups& IntegratorGroups::operator=(const IntegratorGroups& other)
+{
+  if (this == &other)
+    return *this;
+  if (!integrator_->assign(*other.integrator_))
+    integrator_ = other.integrator_->clone();
+  groups_.resize(other.groups_.size());
+  for (std::size_t k = 0; k < groups_.size(); ++k)
+  {
+    Group& group = groups_[k];
+    const Group& theirs = other.groups_[k];
+    group.type = theirs.type;
+    group.model = theirs.model;
+    group.elements = theirs.elements;
+    if (!group.integrator || !group.integrator->assign(*theirs.integrator))
+      group.integrator = theirs.integrator->clone();
+  }
+  scene_type_ = other.scene_type_;
+  body_type_ = other.body_type_;
+  dirty_ = other.dirty_;
+  return *this;
+}
+
 void IntegratorGroups::setAll(IntegratorType type)
 {
   // Every integrator's state is (x, v) plus caches it rebuilds from them: a fresh one continues.

@@ -99,6 +99,17 @@ private:
 /// each constraint (see Integrator::internalForces).
 void stateInternalForces(const Model& model, const State& state, InternalForces& forces);
 
+/// Integrator::assign for an integrator of type T: `self` becomes a copy of `other` if it is a T too.
+template <typename T>
+bool assignIfSame(T& self, const Integrator& other)
+{
+  const auto* same = dynamic_cast<const T*>(&other);
+  if (same == nullptr)
+    return false;
+  self = *same;
+  return true;
+}
+
 /// A force-based scheme: springs and dashpots as forces, constraints by its ConstraintPass.
 class ForceBasedIntegrator : public Integrator
 {

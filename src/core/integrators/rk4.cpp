@@ -13,6 +13,8 @@ namespace
 class Rk4 final : public ForceBasedIntegrator
 {
 public:
+  std::unique_ptr<Integrator> clone() const override { return std::make_unique<Rk4>(*this); }
+  bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
   void step(const Model& model, State& state, double h, int iterations) override
   {
     const NodeArray& x = state.position;

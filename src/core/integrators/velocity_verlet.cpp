@@ -13,6 +13,8 @@ namespace
 class VelocityVerlet final : public ForceBasedIntegrator
 {
 public:
+  std::unique_ptr<Integrator> clone() const override { return std::make_unique<VelocityVerlet>(*this); }
+  bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
   void step(const Model& model, State& state, double h, int iterations) override
   {
     if (!has_acceleration_)

@@ -56,6 +56,8 @@ void solveCell(const PressureCell& cell, const Eigen::VectorXd& inverse_mass, do
 class Xpbd final : public Integrator
 {
 public:
+  std::unique_ptr<Integrator> clone() const override { return std::make_unique<Xpbd>(*this); }
+  bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
   void step(const Model& model, State& state, double h, int iterations) override
   {
     stepWithContacts(model, state, h, iterations, nullptr);

@@ -212,7 +212,7 @@ private:
   static constexpr double kMaxFactorWork = 2000.0;
   static constexpr double kAnyWork = std::numeric_limits<double>::infinity();
 
-  const LinearSolve mode_;
+  LinearSolve mode_;
   int nodes_ = 0;
   std::vector<std::pair<int, int>> pairs_;  ///< the pattern: slot k couples pairs_[k]
   bool chains_ = false;                     ///< the pairs form chains: tridiagonal_solver_ can solve

@@ -127,6 +127,25 @@ bool SparseBlockSolver::analyze(int nodes, const std::vector<std::pair<int, int>
   return true;
 }
 
+SparseBlockSolver::SparseBlockSolver(const SparseBlockSolver& other) { *this = other; }
+
+SparseBlockSolver& SparseBlockSolver::operator=(const SparseBlockSolver& other)
+{
+  if (this == &other)
+    return *this;
+  work_ = other.work_;
+  entries_ = other.entries_;
+  position_ = other.position_;
+  diagonal_ = other.diagonal_;
+  off_diagonal_ = other.off_diagonal_;
+  upper_ = other.upper_;
+  permuted_rhs_ = other.permuted_rhs_;
+  permuted_x_ = other.permuted_x_;
+  if (upper_.rows() > 0)
+    factor_.analyzePattern(upper_);
+  return *this;
+}
+
 int SparseBlockSolver::entryIndex(int row, int column) const
 {
   const int* rows = upper_.innerIndexPtr();

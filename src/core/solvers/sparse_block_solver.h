@@ -26,6 +26,12 @@ class SparseBlockSolver
 public:
   using Matrix3 = Eigen::Matrix3d;
 
+  SparseBlockSolver() = default;
+  /// The pattern and the symbolic factorisation made again from it (Eigen's factorisations cannot be
+  /// copied; the numeric one is made afresh by every factorize, so the copy solves as the original).
+  SparseBlockSolver(const SparseBlockSolver& other);
+  SparseBlockSolver& operator=(const SparseBlockSolver& other);
+
   /// The pattern of a system over `nodes` nodes whose off-diagonal blocks may be non-zero for the node
   /// pairs `pairs` (i != j; a pair may repeat). Slot k of addOffDiagonal is pairs[k]. First counts what
   /// the factorisation would cost (the elimination tree and the column counts of L, node by node, in

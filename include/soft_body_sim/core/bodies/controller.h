@@ -26,6 +26,9 @@ class Controller
 {
 public:
   virtual ~Controller() = default;
+  /// A copy in the same state (its clock, its own dynamics' history): stepped as the original is, it
+  /// gives the same bits.
+  virtual std::unique_ptr<Controller> clone() const = 0;
   /// Advances the procedural motion by dt [s] and writes the positions [m] and velocities [m/s] of its
   /// nodes into `state`; it may read any node (e.g. a root following a torso).
   virtual void step(double dt, State& state) = 0;

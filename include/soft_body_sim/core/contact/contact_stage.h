@@ -112,6 +112,9 @@ class ColliderKind
 {
 public:
   virtual ~ColliderKind() = default;
+  /// A copy with its shapes where they are, their goals and what they touch (a mesh's distance field is
+  /// shared: it never changes).
+  virtual std::unique_ptr<ColliderKind> clone() const = 0;
   /// After a sub-step of h [s] that took the nodes from `start` [m] to state.position: moves its shapes
   /// by h and resolves the contacts of every free node with them. True if it touched any node (the
   /// integrators' caches of the state are then stale).
@@ -167,6 +170,17 @@ public:
       first += kind->count();
     }
   }
+  /// Each kind cloned: its shapes where they are now, with their goals; the paths are shared (a caller's
+  /// function of time; World's copy).
+  ContactStage(const ContactStage& other)
+    : first_(other.first_), dt_(other.dt_), start_(other.start_), paths_(other.paths_)
+  {
+    for (const std::unique_ptr<ColliderKind>& kind : other.kinds_)
+      kinds_.push_back(kind->clone());
+  }
+  ContactStage(ContactStage&&) = default;
+  ContactStage& operator=(ContactStage&&) = default;
+  ContactStage& operator=(const ContactStage& other) { return *this = ContactStage(other); }
 
   /// What the integrators' solves may ask and tell (null without colliders: they pay nothing).
   ContactQuery* query() { return kinds_.empty() ? nullptr : this; }

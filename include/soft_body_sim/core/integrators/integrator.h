@@ -84,6 +84,12 @@ class Integrator
 {
 public:
   virtual ~Integrator() = default;
+  /// A copy carrying everything the next steps depend on (history, multipliers, warm data): stepped as the
+  /// original is, it gives the same bits. Called between steps.
+  virtual std::unique_ptr<Integrator> clone() const = 0;
+  /// Makes this one a copy of `other` (as clone), reusing its buffers; false (and unchanged) if `other` is
+  /// of another kind.
+  virtual bool assign(const Integrator& other) = 0;
   /// Advances `state` by h [s]. Pinned nodes (inverse mass 0) are never moved: their position and
   /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
   virtual void step(const Model& model, State& state, double h, int iterations) = 0;

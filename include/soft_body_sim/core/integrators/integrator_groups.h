@@ -17,6 +17,13 @@ class IntegratorGroups
 {
 public:
   IntegratorGroups(IntegratorType scene_type, std::size_t bodies);
+  /// Every integrator cloned (Integrator::clone): the copy steps on as the original would.
+  IntegratorGroups(const IntegratorGroups& other);
+  IntegratorGroups(IntegratorGroups&&) = default;
+  IntegratorGroups& operator=(IntegratorGroups&&) = default;
+  /// As the copy; integrators of the same kinds in the same groups take the other's state into their
+  /// own buffers (Integrator::assign).
+  IntegratorGroups& operator=(const IntegratorGroups& other);
 
   /// The scene's integrator (setAll's).
   IntegratorType sceneType() const { return scene_type_; }

@@ -48,6 +48,9 @@ class ImplicitEuler final : public ForceBasedIntegrator
 {
 public:
   explicit ImplicitEuler(LinearSolve linear_solve) : system_(linear_solve) {}
+  /// Between steps (contacts_ is null then): the pattern, the holds' forces, everything carried.
+  std::unique_ptr<Integrator> clone() const override { return std::make_unique<ImplicitEuler>(*this); }
+  bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
 
   void modelChanged() override { analyzed_ = false; }
 
