@@ -74,8 +74,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     const State& a = world.state();
     const State& b = clone.state();
-    const auto same = [](const auto& x, const auto& y) {
-      return x.size() == y.size() && std::memcmp(x.data(), y.data(), sizeof(double) * static_cast<std::size_t>(x.size())) == 0;
+    const auto same = [](const auto& x, const auto& y) {  // bit for bit (an empty array's data is null)
+      return x.size() == y.size() &&
+             (x.size() == 0 || std::memcmp(x.data(), y.data(), sizeof(double) * static_cast<std::size_t>(x.size())) == 0);
     };
     if (!same(a.position, b.position) || !same(a.velocity, b.velocity) || !same(a.twist, b.twist))
     {
