@@ -1,5 +1,6 @@
 // libFuzzer harness for the scene parser: any bytes are parsed as a scene file; a scene that loads is
-// built and stepped a little, and a clone of it made mid-way must step on to the same bits. Only
+// built and stepped a little, and a clone of it made mid-way, and a world built afresh and restored from the
+// snapshot's bytes, must step on to the same bits. Only
 // SceneError (and buildWorld's std::invalid_argument) may come out, and a SceneError must be one printable
 // line that names the file; a crash, a sanitizer report, a slow input (-timeout), an input that takes too
 // much memory (-rss_limit_mb), a clone that steps on differently or any other exception is a finding.
@@ -61,27 +62,43 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     return 0;
   try
   {
-    // Three steps, a clone, two more steps of each: the clone must end on the same bits (World's copy
-    // carries everything the future depends on), NaN or not.
+    // Three steps, a clone and a world restored from the snapshot's bytes, two more steps of each: they
+    // must end on the same bits (World's copy and its bytes carry everything the future depends on), NaN
+    // or not.
     World world = buildWorld(scene);
+    World fresh = buildWorld(scene);
     for (int n = 0; n < 3; ++n)
       world.step();
     World clone(world);
+    try
+    {
+      fresh.restore(WorldSnapshot::fromBytes(world.snapshot().toBytes()));
+    }
+    catch (const std::invalid_argument& e)
+    {
+      std::fprintf(stderr, "a world refused its own snapshot's bytes: %s\n", e.what());
+      std::abort();
+    }
     for (int n = 0; n < 2; ++n)
     {
       world.step();
       clone.step();
+      fresh.step();
     }
-    const State& a = world.state();
-    const State& b = clone.state();
     const auto same = [](const auto& x, const auto& y) {  // bit for bit (an empty array's data is null)
       return x.size() == y.size() &&
              (x.size() == 0 || std::memcmp(x.data(), y.data(), sizeof(double) * static_cast<std::size_t>(x.size())) == 0);
     };
-    if (!same(a.position, b.position) || !same(a.velocity, b.velocity) || !same(a.twist, b.twist))
+    const State& a = world.state();
+    for (const World* other : { &clone, &fresh })
     {
-      std::fprintf(stderr, "a clone stepped on to other bits than its original\n");
-      std::abort();
+      const State& b = other->state();
+      if (!same(a.position, b.position) || !same(a.velocity, b.velocity) || !same(a.twist, b.twist))
+      {
+        std::fprintf(stderr, "a %s stepped on to other bits than its original\n",
+                     other == &clone ? "clone" : "world restored from bytes");
+        std::abort();
+      }
     }
   }
   catch (const std::invalid_argument&)

@@ -12,7 +12,10 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -259,8 +262,9 @@ TEST(Determinism, EveryExampleAndHardCaseSceneGivesItsPinnedBits)
 TEST(Determinism, AWorldClonedOrRestoredMidRunStepsOnToTheSameBits)
 {
   // Every run of the first test, interrupted a third of the way (after the anchors began circling, before
-  // the targets jump): a clone (World's copy) stepped on with the same inputs, and the world itself stepped
-  // on, restored to a snapshot of that moment and stepped on again, each end on the run's pinned bits.
+  // the targets jump): a clone (World's copy) stepped on with the same inputs, the world itself stepped
+  // on, restored to a snapshot of that moment and stepped on again, and a world built afresh from the
+  // scene, restored from that snapshot's bytes, each end on the run's pinned bits.
   std::size_t checked = 0;
   for (const std::string& path : scenes())
   {
@@ -275,6 +279,7 @@ TEST(Determinism, AWorldClonedOrRestoredMidRunStepsOnToTheSameBits)
       rollout.stepInputs(rollout.world, 0, split);
       World clone(rollout.world);
       const WorldSnapshot moment = rollout.world.snapshot();
+      const std::string bytes = moment.toBytes();
       rollout.stepInputs(rollout.world, split, rollout.steps);
       EXPECT_EQ(hashOf(rollout.world), pinned->hash) << path << " with " << name;
       rollout.stepInputs(clone, split, rollout.steps);
@@ -283,6 +288,11 @@ TEST(Determinism, AWorldClonedOrRestoredMidRunStepsOnToTheSameBits)
       EXPECT_EQ(rollout.world.stepCount(), split);
       rollout.stepInputs(rollout.world, split, rollout.steps);
       EXPECT_EQ(hashOf(rollout.world), pinned->hash) << path << " with " << name << ": restored";
+      Rollout fresh(scene, integrator);
+      fresh.world.restore(WorldSnapshot::fromBytes(bytes));
+      EXPECT_EQ(fresh.world.stepCount(), split);
+      fresh.stepInputs(fresh.world, split, rollout.steps);
+      EXPECT_EQ(hashOf(fresh.world), pinned->hash) << path << " with " << name << ": from bytes";
       ++checked;
     }
   }
@@ -309,6 +319,64 @@ TEST(Determinism, ASnapshotOfAnotherSceneIsRefusedNamingBoth)
   }
   EXPECT_EQ(rope.state().position, before.position);  // untouched
   EXPECT_EQ(rope.stepCount(), 1);
+}
+
+/// The message of the std::invalid_argument that `f` throws, or "" if it throws none.
+template <typename F>
+std::string refusal(F f)
+{
+  try
+  {
+    f();
+  }
+  catch (const std::invalid_argument& e)
+  {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Determinism, SnapshotBytesOfAnotherSceneOrDamagedAreRefusedAndChangeNothing)
+{
+  World rope = buildWorld(loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/rope.yaml"));
+  World cloth = buildWorld(loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/cloth.yaml"));
+  cloth.step();
+  rope.step();
+  const std::string cloth_bytes = cloth.snapshot().toBytes();
+  std::string rope_bytes = rope.snapshot().toBytes();
+  rope.step();
+  const State before = rope.state();
+
+  const std::string other = refusal([&] { rope.restore(WorldSnapshot::fromBytes(cloth_bytes)); });
+  EXPECT_NE(other.find("cloth ("), std::string::npos) << other;
+  EXPECT_NE(other.find("rope ("), std::string::npos) << other;
+  // The same scene with another stiffness is another scene: its fingerprint differs.
+  std::ifstream file(std::string(SOURCE_DIR) + "/config/scenes/rope.yaml");
+  std::string text((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  ASSERT_NE(text.find("stiffness: 200.0"), std::string::npos);
+  text.replace(text.find("stiffness: 200.0"), 16, "stiffness: 400.0");
+  World stiff = buildWorld(parseScene(text, "<a stiffer rope>"));
+  EXPECT_NE(stiff.fingerprint(), rope.fingerprint());
+  EXPECT_NE(refusal([&] { stiff.restore(WorldSnapshot::fromBytes(rope_bytes)); }).find("another scene"),
+            std::string::npos);
+
+  EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes(rope_bytes.substr(0, rope_bytes.size() - 1)); }).find("damaged"),
+            std::string::npos);
+  EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes(rope_bytes.substr(0, 20)); }).find("end early"), std::string::npos);
+  EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes("not a snapshot at all"); }).find("not a soft_body_sim snapshot"),
+            std::string::npos);
+  std::string flipped = rope_bytes;
+  flipped[flipped.size() / 2] = static_cast<char>(flipped[flipped.size() / 2] ^ 1);
+  EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes(flipped); }).find("damaged"), std::string::npos);
+  std::string newer = rope_bytes;
+  newer[12] = static_cast<char>(newer[12] + 1);  // the version, after the magic and the byte-order marker
+  EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes(newer); }).find("format version"), std::string::npos);
+
+  EXPECT_EQ(rope.state().position, before.position);  // untouched by every refusal
+  EXPECT_EQ(rope.stepCount(), 2);
+  rope.restore(WorldSnapshot::fromBytes(rope_bytes));
+  EXPECT_EQ(rope.stepCount(), 1);
+  EXPECT_DOUBLE_EQ(WorldSnapshot::fromBytes(rope_bytes).time(), rope.time());
 }
 
 }  // namespace

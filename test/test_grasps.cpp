@@ -212,7 +212,9 @@ TEST(GraspSnapshot, AGraspedClothPushedByAMovingSphereStepsOnBitForBitFromASnaps
   // The cloth's corner in a gripper that lifts it along a path (a grasp with a force limit), a sphere
   // rising into the hanging cloth along a path: both carried in a world's snapshot and clone (goals,
   // paths, held offsets, the sphere's pose and what it touches, the integrator's carried state). 60 steps
-  // after the moment, the restored world and the clone are where the world itself was, to the bit.
+  // after the moment, the restored world and the clone are where the world itself was, to the bit; so is
+  // a world built afresh from the scene, restored from the snapshot's bytes and given the same paths (bytes
+  // carry no functions).
   for (const IntegratorType integrator : { IntegratorType::Xpbd, IntegratorType::ImplicitEuler })
   {
     SceneDef scene = clothScene(integrator);
@@ -224,22 +226,29 @@ TEST(GraspSnapshot, AGraspedClothPushedByAMovingSphereStepsOnBitForBitFromASnaps
     scene.bodies[0].contact_radius = 0.01;
     World world = buildWorld(scene);
     world.grasp("gripper", "cloth", poseAt(Vec3(0, 0, 1)), 0.12, 20.0);
-    ASSERT_TRUE(world.followGraspPath("gripper", [](double t) { return poseAt(Vec3(0, 0, 1 + 0.3 * t)); }));
-    ASSERT_TRUE(world.followColliderPath("ball", [](double t) { return poseAt(Vec3(0.25, 0.25, 0.5 + 0.3 * t)); }));
+    const auto lift = [](double t) { return poseAt(Vec3(0, 0, 1 + 0.3 * t)); };
+    const auto rise = [](double t) { return poseAt(Vec3(0.25, 0.25, 0.5 + 0.3 * t)); };
+    ASSERT_TRUE(world.followGraspPath("gripper", lift));
+    ASSERT_TRUE(world.followColliderPath("ball", rise));
     for (int n = 0; n < 40; ++n)
       world.step();
     const WorldSnapshot moment = world.snapshot();
     World clone(world);
+    World fresh = buildWorld(scene);
+    fresh.restore(WorldSnapshot::fromBytes(moment.toBytes()));
+    ASSERT_TRUE(fresh.followGraspPath("gripper", lift));
+    ASSERT_TRUE(fresh.followColliderPath("ball", rise));
     for (int n = 0; n < 60; ++n)
       world.step();
     const std::vector<double> later = observed(world);
-    for (World* other : { &clone, &world })
+    for (World* other : { &clone, &fresh, &world })
     {
       if (other == &world)
         world.restore(moment);
       for (int n = 0; n < 60; ++n)
         other->step();
-      EXPECT_EQ(observed(*other), later) << integratorName(integrator) << (other == &world ? ": restored" : ": clone");
+      EXPECT_EQ(observed(*other), later)
+          << integratorName(integrator) << (other == &world ? ": restored" : other == &fresh ? ": from bytes" : ": clone");
     }
     // The moment did matter: the sphere reached the cloth and the grasp bore a load.
     EXPECT_GT(world.colliderWrenches().at(0).wrench.force.norm(), 0.0) << integratorName(integrator);

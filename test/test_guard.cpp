@@ -159,6 +159,7 @@ class RunawayController final : public Controller
 {
 public:
   std::unique_ptr<Controller> clone() const override { return std::make_unique<RunawayController>(*this); }
+  void carry(StateArchive& /*archive*/) override {}  // no state of its own: it doubles what it finds
   explicit RunawayController(int node) : node_(node) {}
   void step(double dt, State& state) override
   {

@@ -97,33 +97,6 @@ void World::snapshot(WorldSnapshot& into) const
     into = snapshot();
 }
 
-double WorldSnapshot::time() const { return world_->time(); }
-
-std::int64_t WorldSnapshot::stepCount() const { return world_->stepCount(); }
-
-namespace
-{
-/// What a scene is made of, to tell two apart: its bodies (name and node count) and its element counts.
-std::string sceneSummary(const Model& model)
-{
-  std::string summary;
-  for (const BodyRange& body : model.bodies)
-    summary += (summary.empty() ? "" : ", ") + body.name + " (" + std::to_string(body.count) + " nodes)";
-  return summary + "; " + std::to_string(model.springs.size()) + " springs, " +
-         std::to_string(model.constraints.size()) + " constraints, " + std::to_string(model.rods.size()) +
-         " rods, " + std::to_string(model.tetrahedra.size()) + " tetrahedra";
-}
-}  // namespace
-
-void World::restore(const WorldSnapshot& snapshot)
-{
-  const std::string theirs = sceneSummary(snapshot.world_->model_), ours = sceneSummary(model_);
-  if (theirs != ours)
-    throw std::invalid_argument("World::restore: a snapshot of another scene (bodies " + theirs +
-                                ") cannot be restored into this one (bodies " + ours + ")");
-  *this = *snapshot.world_;
-}
-
 void World::step()
 {
   const double dt = settings_.dt;

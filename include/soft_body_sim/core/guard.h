@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -53,6 +54,8 @@ struct GuardSettings
   /// dragged 10 m in one 1 ms sub-step moves at 10^4 m/s) and far below what a diverging scheme reaches
   /// within a few steps (its energy grows geometrically, by (omega h)^2 per step for explicit Euler).
   double max_speed = 1.0e5;
+
+  void carry(StateArchive& archive) { archive(policy, max_speed); }
 };
 
 /// One catch of the guard, for the caller to report.
@@ -65,6 +68,8 @@ struct DivergenceEvent
 
   /// "body 'rope' diverged at t = 1.250 s (REASON): restored to its last good state, ACTION".
   std::string describe() const;
+
+  void carry(StateArchive& archive) { archive(body, time, reason, action); }
 };
 
 /// The guard's memory: the last good state, which bodies it froze, what it caught. The world runs it as
@@ -102,6 +107,9 @@ public:
   std::int64_t count(std::size_t body) const { return body_counts_.at(body); }
   /// The catches since the last call, oldest first.
   std::vector<DivergenceEvent> takeEvents();
+
+  /// Writes or reads all of it (state_archive.h).
+  void carry(StateArchive& archive) { archive(settings_, last_good_, frozen_, body_counts_, count_, events_); }
 
 private:
   /// True if body `body` is certainly fine (false says: look closer).

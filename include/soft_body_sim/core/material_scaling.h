@@ -17,6 +17,8 @@ struct BodyScaling
   double stiffness = 1.0;  ///< [-] spring stiffness k, constraint stiffness 1 / compliance, a rod's E I and G J, a solid's E
   double damping = 1.0;    ///< [-] spring dashpots c, a rod's damping beta
   double pressure = 1.0;   ///< [-] rest gas pressure p0 of the body's cells and tetrahedra
+
+  void carry(StateArchive& archive) { archive(stiffness, damping, pressure); }
 };
 
 class MaterialScaling
@@ -32,6 +34,11 @@ public:
   const BodyScaling& of(std::size_t body) const { return scaling_.at(body); }
   /// True if body `body` was built with elements of any kind: a material to scale.
   bool has(std::size_t body) const { return has_material_.at(body) != 0; }
+  /// The element arrays as built (the rest of this model is empty).
+  const Model& built() const { return *built_; }
+
+  /// Writes or reads the factors (state_archive.h); what they multiply is the scene's.
+  void carry(StateArchive& archive) { archive(scaling_); }
 
 private:
   /// The elements as built (its element arrays only); never changed, so copies of a world share it.

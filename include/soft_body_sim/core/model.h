@@ -13,6 +13,7 @@
 #include <Eigen/Geometry>
 
 #include "soft_body_sim/core/contact/colliders.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -30,6 +31,8 @@ struct Spring
   double rest_length = 0.0;  ///< [m]
   double stiffness = 0.0;    ///< k [N/m], > 0
   double damping = 0.0;      ///< c [N s/m], >= 0
+
+  void carry(StateArchive& archive) { archive(a, b, rest_length, stiffness, damping); }
 };
 
 /// Distance constraint C = |x_a - x_b| - rest_length, solved by projection (XPBD, Macklin et al. 2016).
@@ -40,6 +43,8 @@ struct DistanceConstraint
   int b = 0;
   double rest_length = 0.0;  ///< [m]
   double compliance = 0.0;   ///< alpha [m/N], >= 0
+
+  void carry(StateArchive& archive) { archive(a, b, rest_length, compliance); }
 };
 
 /// A gas-filled quadrilateral cell of a 2D body (jelly): four nodes, counter-clockwise about `normal`.
@@ -53,6 +58,8 @@ struct PressureCell
   Vec3 normal = Vec3::UnitZ();  ///< unit normal of the cell's plane
   double rest_area = 0.0;       ///< A0 [m^2], > 0
   double pressure = 0.0;        ///< p0 [N/m] (2D pressure: force per length of outline), > 0
+
+  void carry(StateArchive& archive) { archive(nodes, normal, rest_area, pressure); }
 };
 
 /// Where a rod is held in position and orientation (rods.h): its nodes first .. last, pinned, and the
@@ -69,6 +76,8 @@ struct RodStation
   /// The same frames in the frame of whatever holds the station (a grasp's frame, an anchor's turn): when
   /// it turns by q, frame[c] = q * held[c].
   Eigen::Quaterniond held[2] = { Eigen::Quaterniond::Identity(), Eigen::Quaterniond::Identity() };
+
+  void carry(StateArchive& archive) { archive(first, last, frame, held); }
 
   /// The holder is at orientation q now (unit).
   void turn(const Eigen::Quaterniond& q)
@@ -98,6 +107,12 @@ struct Rod
   /// couple across its last segment: its part along that segment is not (a free end holds no twist).
   Vec3 end_moment = Vec3::Zero();
 
+  void carry(StateArchive& archive)
+  {
+    archive(first, count, segment_length, bending_stiffness, twisting_stiffness, damping, rest_frame, stations,
+            end_moment);
+  }
+
   int last() const { return first + count - 1; }
 };
 
@@ -112,6 +127,8 @@ struct Tetrahedron
   double mu = 0.0;           ///< Lame's second parameter, the shear modulus E / (2 (1 + nu)) [Pa], > 0
   double lambda = 0.0;       ///< Lame's first parameter E nu / ((1 + nu)(1 - 2 nu)) [Pa], >= 0
   double pressure = 0.0;     ///< p0 [Pa] of the gas it holds (tetrahedra.h), >= 0; 0: no gas
+
+  void carry(StateArchive& archive) { archive(nodes, rest_inverse, rest_volume, mu, lambda, pressure); }
 };
 
 /// [m] The radius a body without a contact radius is seen with (a camera; rviz draws its nodes as balls of
@@ -129,6 +146,8 @@ struct Look
   std::vector<int> balls;                  ///< nodes in no tube or face
   double radius = kDefaultLookRadius;      ///< [m] of its tubes and balls: its contact radius if it has one
   Eigen::Vector3d color = Eigen::Vector3d::Constant(0.6);  ///< rgb in [0, 1]
+
+  void carry(StateArchive& archive) { archive(tubes, faces, balls, radius, color); }
 };
 
 /// The colour of body `body` (its index in the scene) when the scene gives none: golden-angle hues, distinct
@@ -153,6 +172,11 @@ struct BodyRange
   /// two solids use the mean of theirs); 0 for every other body.
   double surface_friction = 0.0;
   Look look;  ///< how a camera and rviz see it
+
+  void carry(StateArchive& archive)
+  {
+    archive(name, first, count, self_collision, self_friction, springs_collide, surface, surface_friction, look);
+  }
 };
 
 /// A point of a solid's boundary triangle, at fixed barycentric weights of its three nodes (summing to 1),
@@ -161,6 +185,8 @@ struct SurfaceSample
 {
   std::array<int, 3> triangle;  ///< node indices, counter-clockwise seen from outside
   Vec3 weight;                  ///< of triangle[0], [1], [2]
+
+  void carry(StateArchive& archive) { archive(triangle, weight); }
 };
 
 /// A named node of a body that the caller moves kinematically (its node is pinned).
@@ -170,6 +196,8 @@ struct Anchor
   std::string name;
   int node = 0;       ///< global node index
   std::string frame;  ///< a tf frame whose origin the ROS node makes it follow; empty = its pose topic
+
+  void carry(StateArchive& archive) { archive(body, name, node, frame); }
 };
 
 /// What the scene is (topology and parameters), apart from where it is now (State). Its topology stays
@@ -202,6 +230,13 @@ struct Model
   Vec3 gravity = Vec3(0.0, 0.0, -9.81);  ///< [m/s^2]
   double drag = 0.0;                      ///< linear air drag [1/s]: a -= drag * v on free nodes
 
+  /// Everything but the colliders (the contact stage carries where they are now; the rest the scene fixes).
+  void carry(StateArchive& archive)
+  {
+    archive(mass, inverse_mass, contact_radius, contact_segments, contact_triangles, springs, constraints, cells,
+            rods, tetrahedra, surface_samples, bodies, anchors, gravity, drag);
+  }
+
   int nodeCount() const { return static_cast<int>(mass.size()); }
   bool isFree(int i) const { return inverse_mass[i] > 0.0; }
   /// A holder (an attached anchor, a grasp) lets node `node` go: it is free again, inverse mass 1 / mass,
@@ -226,6 +261,8 @@ struct State
   /// and the next station along its rod, counted on through whole turns; 0 at every other node. One
   /// entry per node when the model has rods, none otherwise.
   Eigen::VectorXd twist;
+
+  void carry(StateArchive& archive) { archive(position, velocity, twist); }
 };
 
 /// How a step is taken: the world advances dt per step in `substeps` equal sub-steps.
@@ -234,6 +271,8 @@ struct StepSettings
   double dt = 0.001;   ///< [s] fixed physics step, > 0
   int substeps = 1;    ///< sub-steps per step, >= 1
   int iterations = 1;  ///< constraint/relaxation iterations (implicit_euler: Newton iterations), >= 1
+
+  void carry(StateArchive& archive) { archive(dt, substeps, iterations); }
 };
 
 }  // namespace soft_body_sim

@@ -21,6 +21,7 @@
 #include "soft_body_sim/core/model.h"
 #include "soft_body_sim/core/holding/reactions.h"
 #include "soft_body_sim/core/contact/self_contacts.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -45,10 +46,29 @@ public:
   double time() const;
   std::int64_t stepCount() const;
 
+  /// The snapshot as bytes, to keep in a file or send to another process: a header (the format and its
+  /// version, a fingerprint of the scene and its bodies in words, the time and step count, a checksum of
+  /// the rest) and then every value a clone copies but the paths, which are functions (docs/physics.md,
+  /// "Snapshots and clones"). Only a build of the same format version on a machine of the same byte order
+  /// reads them.
+  std::string toBytes() const;
+  /// A snapshot of bytes from toBytes, to restore into a world of the same scene. Throws
+  /// std::invalid_argument, saying which, for bytes that are no snapshot, of another format version or
+  /// byte order, damaged (the checksum) or cut short.
+  static WorldSnapshot fromBytes(std::string bytes);
+
 private:
   friend class World;
   explicit WorldSnapshot(std::shared_ptr<World> world) : world_(std::move(world)) {}
-  std::shared_ptr<World> world_;  ///< never changed while shared (copies of a snapshot share it)
+  WorldSnapshot() = default;
+
+  std::shared_ptr<World> world_;  ///< never changed while shared (copies of a snapshot share it); or null:
+  std::shared_ptr<const std::string> bytes_;  ///< a snapshot read from bytes: all of them
+  std::size_t body_ = 0;          ///< where in bytes_ the values begin, after the header
+  std::uint64_t fingerprint_ = 0; ///< the header's (World::fingerprint)
+  std::string summary_;           ///< the header's: the scene's bodies in words
+  double time_ = 0.0;             ///< [s] the header's
+  std::int64_t steps_ = 0;        ///< the header's
 };
 
 class World
@@ -76,9 +96,15 @@ public:
   /// each cycle allocates little).
   void snapshot(WorldSnapshot& into) const;
   /// Back to the moment `snapshot` took (of this world or of another of the same scene: the same bodies,
-  /// node counts and elements), as copy assignment. Throws std::invalid_argument, naming both scenes'
-  /// bodies, for a snapshot of another scene.
+  /// node counts and elements), as copy assignment; a snapshot of bytes keeps this world's paths, for the
+  /// scene's anchors, the grasps of the same names and the colliders. Throws std::invalid_argument, naming
+  /// both scenes' bodies, for a snapshot of another scene (for bytes: another fingerprint), or saying what
+  /// is wrong with bytes that do not read; the world is unchanged then.
   void restore(const WorldSnapshot& snapshot);
+  /// Tells scenes apart: a hash of what the scene fixes (the bodies, masses, contact radii and geometry,
+  /// the elements as built, the colliders as declared), not of what changes as it runs. Two worlds built
+  /// from the same scene file have the same.
+  std::uint64_t fingerprint() const;
 
   /// Advances the simulation by settings().dt [s], as the named stages in world.cpp.
   void step();
@@ -227,6 +253,10 @@ public:
   std::vector<DivergenceEvent> takeDivergenceEvents() { return guard_.takeEvents(); }
 
 private:
+  friend class WorldSnapshot;  // its bytes are the world's values
+  /// Writes or reads every value a copy copies but the paths and the integration observer (state_archive.h).
+  void carry(StateArchive& archive);
+
   // The stages of step(), in their order.
   /// Controllers and anchors set their nodes for this step; true if any kinematic node moves.
   bool driveKinematicNodes(double dt);

@@ -57,6 +57,10 @@ class CreatureController final : public Controller
 {
 public:
   std::unique_ptr<Controller> clone() const override { return std::make_unique<CreatureController>(*this); }
+  void carry(StateArchive& archive) override
+  {
+    archive(clock_, x_, x_previous_, drawn_from_, target_, anticipate_);
+  }
   CreatureController(const CreatureDef& def, int first_node)
     : def_(def)
     , first_node_(first_node)

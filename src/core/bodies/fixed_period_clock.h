@@ -63,6 +63,8 @@ public:
 
   double period() const { return period_; }
 
+  void carry(StateArchive& archive) { archive(elapsed_periods_, reached_, started_); }
+
 private:
   double period_;
   double max_periods_per_step_;

@@ -46,6 +46,10 @@ class HumanoidController final : public Controller
 {
 public:
   std::unique_ptr<Controller> clone() const override { return std::make_unique<HumanoidController>(*this); }
+  void carry(StateArchive& archive) override
+  {
+    archive(clock_, pelvis_, pelvis_previous_, pelvis_from_, target_, limbs_, joint_from_, leaf_from_);
+  }
   HumanoidController(const HumanoidDef& def, const TorsoFrame& frame, int first_node)
     : def_(def)
     , frame_(frame)

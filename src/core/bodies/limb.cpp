@@ -24,6 +24,7 @@ class LimbController final : public Controller
 {
 public:
   std::unique_ptr<Controller> clone() const override { return std::make_unique<LimbController>(*this); }
+  void carry(StateArchive& archive) override { archive(clock_, dynamics_, joint_from_, leaf_from_); }
   LimbController(const LimbDef& def, int first_node, const Vec3& joint, const Vec3& leaf)
     : first_node_(first_node)
     , samples_(def.motion.curve_samples)

@@ -32,6 +32,7 @@ class PlaneContacts final : public ColliderKind
 {
 public:
   std::unique_ptr<ColliderKind> clone() const override { return std::make_unique<PlaneContacts>(*this); }
+  void carry(StateArchive& archive) override { archive(touching_, received_); }
   /// Keeps the planes with unit normals; throws std::invalid_argument on a zero normal.
   PlaneContacts(std::vector<Plane> planes, int nodes);
 

@@ -112,6 +112,14 @@ class ShapeContacts final : public ColliderKind
 {
 public:
   std::unique_ptr<ColliderKind> clone() const override { return std::make_unique<ShapeContacts>(*this); }
+  /// The shapes' motion, goals and contacts; the rest of a copy is fixed by the scene or made anew each
+  /// sub-step.
+  void carry(StateArchive& archive) override
+  {
+    for (Shape& shape : shapes_)
+      archive(shape.at.position, shape.at.orientation, shape.at.velocity, shape.at.angular_velocity);
+    archive(goals_, placed_, touching_, received_);
+  }
   /// `faces`: the model has contact triangles (the shapes' features are made only then: a mesh's take a
   /// pass over its edges).
   ShapeContacts(std::vector<Shape> shapes, int nodes, bool faces)

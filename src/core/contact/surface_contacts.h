@@ -49,6 +49,8 @@ struct SurfaceTouch
   double friction;  ///< Coulomb coefficient: the solid's `friction`, the mean of two solids'
   /// -1 for a node on a triangle (nodes[0] is the node); for two edges, a number no other pair of edges has
   std::int64_t edges = -1;
+
+  void carry(StateArchive& archive) { archive(nodes, weights, normal, depth, edges); }
 };
 
 class SurfaceContacts

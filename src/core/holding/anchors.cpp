@@ -97,6 +97,16 @@ void AnchorSet::removed(std::size_t k)
   turned_from_.erase(turned_from_.begin() + static_cast<std::ptrdiff_t>(k));
 }
 
+void AnchorSet::carry(StateArchive& archive)
+{
+  archive(goals_, turns_, turned_from_, scene_anchors_);
+  if (archive.reading())
+  {
+    paths_.resize(scene_anchors_);
+    paths_.resize(goals_.size());
+  }
+}
+
 bool AnchorSet::isAttached(int k) const
 {
   return k >= 0 && static_cast<std::size_t>(k) >= scene_anchors_ && static_cast<std::size_t>(k) < goals_.size();

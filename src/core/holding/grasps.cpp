@@ -96,6 +96,22 @@ bool GraspSet::setGoal(const std::string& name, const RigidPose& pose)
   return true;
 }
 
+void GraspSet::carry(StateArchive& archive)
+{
+  if (!archive.reading())
+  {
+    archive(grasps_, goals_);
+    return;
+  }
+  const std::vector<GraspedNodes> before = grasps_;
+  std::vector<GraspPath> paths_before = std::move(paths_);
+  archive(grasps_, goals_);
+  paths_.assign(grasps_.size(), GraspPath{});
+  for (std::size_t k = 0; k < before.size(); ++k)
+    if (const std::size_t now = find(before[k].name); now < grasps_.size())
+      paths_[now] = std::move(paths_before[k]);
+}
+
 bool GraspSet::followPath(const std::string& name, GraspPath path)
 {
   const std::size_t k = find(name);

@@ -15,6 +15,8 @@ struct ChainPath
 {
   std::vector<int> nodes;
   std::vector<std::size_t> rows;
+
+  void carry(StateArchive& archive) { archive(nodes, rows); }
 };
 
 /// Colliders holding the nodes of XPBD's chains (chain_solver.h) inside the chains' solve, with Coulomb
@@ -83,6 +85,11 @@ public:
   }
 
   const NodeHolds& holds() const { return holds_; }
+
+  void carry(StateArchive& archive)
+  {
+    archive(paths_, nodes_, holds_, before_, predicted_, contact_, slip_, impulse_, pressed_, force_);
+  }
 
 private:
   /// Calls visit(path, first, end) for every run nodes[first, end) of held nodes.

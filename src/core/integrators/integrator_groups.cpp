@@ -1,6 +1,7 @@
 #include "soft_body_sim/core/integrators/integrator_groups.h"
 
 #include <algorithm>
+#include <stdexcept>
 
 #include "core/elements/element_kinds.h"
 
@@ -114,6 +115,31 @@ void IntegratorGroups::modelChanged()
     group.integrator->modelChanged();
   if (!groups_.empty())
     dirty_ = true;
+}
+
+void IntegratorGroups::carry(StateArchive& archive, const Model& model)
+{
+  // Dirty groups are made again, with fresh integrators, by the next step's prepare: none are written.
+  const IntegratorType scene_type = scene_type_;
+  std::size_t groups = dirty_ ? 0 : groups_.size();
+  archive(scene_type_, body_type_, dirty_, groups);
+  if (archive.reading())
+  {
+    if (scene_type_ != scene_type)
+      integrator_ = makeIntegrator(scene_type_);
+    if (body_type_.size() != model.bodies.size())
+      throw std::invalid_argument("snapshot bytes: integrators for another number of bodies");
+    const bool dirty = dirty_;
+    groups_.clear();
+    if (groups > 0)
+      rebuild(model);
+    dirty_ = dirty;
+    if (groups_.size() != groups)
+      throw std::invalid_argument("snapshot bytes: integrator groups that this model does not make");
+  }
+  integrator_->carry(archive, model);
+  for (std::size_t k = 0; k < groups; ++k)
+    groups_[k].integrator->carry(archive, groups_[k].model);
 }
 
 void IntegratorGroups::rebuild(const Model& model)

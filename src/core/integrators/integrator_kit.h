@@ -19,6 +19,8 @@ struct SweepRow
   double alpha_tilde;
   double gamma;
   double inverse_denominator;
+
+  void carry(StateArchive& archive) { archive(a, b, rest_length, alpha_tilde, gamma, inverse_denominator); }
 };
 
 inline SweepRow sweepRow(const ConstraintRow& row, const Eigen::VectorXd& inverse_mass)
@@ -89,6 +91,8 @@ public:
       tension = -lambda_ / (h_ * h_);
   }
 
+  void carry(StateArchive& archive) { archive(lambda_, h_); }
+
 private:
   NodeArray unprojected_;
   Eigen::VectorXd lambda_;
@@ -119,6 +123,7 @@ public:
     stateInternalForces(model, state, forces);
     constraints_.tensions(model, forces.tension.tail(static_cast<Eigen::Index>(model.constraints.size())));
   }
+  void carry(StateArchive& archive, const Model& /*model*/) override { archive(constraints_); }
 
 protected:
   ConstraintPass constraints_;

@@ -15,6 +15,11 @@ class VelocityVerlet final : public ForceBasedIntegrator
 public:
   std::unique_ptr<Integrator> clone() const override { return std::make_unique<VelocityVerlet>(*this); }
   bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
+  void carry(StateArchive& archive, const Model& model) override
+  {
+    ForceBasedIntegrator::carry(archive, model);
+    archive(has_acceleration_, acceleration_);
+  }
   void step(const Model& model, State& state, double h, int iterations) override
   {
     if (!has_acceleration_)

@@ -20,6 +20,11 @@ class Verlet final : public ForceBasedIntegrator
 public:
   std::unique_ptr<Integrator> clone() const override { return std::make_unique<Verlet>(*this); }
   bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
+  void carry(StateArchive& archive, const Model& model) override
+  {
+    ForceBasedIntegrator::carry(archive, model);
+    archive(has_history_, h_, previous_acceleration_);
+  }
   void step(const Model& model, State& state, double h, int iterations) override
   {
     computeAccelerations(model, state.position, state.velocity, force_, acceleration_);

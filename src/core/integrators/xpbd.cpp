@@ -58,6 +58,14 @@ class Xpbd final : public Integrator
 public:
   std::unique_ptr<Integrator> clone() const override { return std::make_unique<Xpbd>(*this); }
   bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
+  /// The chain solver's buffers are made anew by every solve; the rest is carried.
+  void carry(StateArchive& archive, const Model& /*model*/) override
+  {
+    archive(order_, swept_count_, chain_starts_, ordered_nodes_, chain_contacts_, chain_heavy_, swept_chain_,
+            correction_, chain_tension_, rows_, rows_h_, reorder_, lambda_, solved_h_, cell_lambda_);
+    if (archive.reading())
+      reserveChains();
+  }
   void step(const Model& model, State& state, double h, int iterations) override
   {
     stepWithContacts(model, state, h, iterations, nullptr);
@@ -250,14 +258,9 @@ private:
     swept_count_ = order_.size();
     order_.insert(order_.end(), partition.chain_rows.begin(), partition.chain_rows.end());
     chain_starts_.clear();
-    std::size_t longest = 0;
-    for (std::size_t c = 0; c < partition.chain_starts.size(); ++c)
-    {
-      chain_starts_.push_back(swept_count_ + partition.chain_starts[c]);
-      if (c > 0)
-        longest = std::max<std::size_t>(longest, partition.chain_starts[c] - partition.chain_starts[c - 1]);
-    }
-    chains_.reserve(longest);
+    for (const std::size_t start : partition.chain_starts)
+      chain_starts_.push_back(swept_count_ + start);
+    reserveChains();
     chain_tension_.setZero(static_cast<Eigen::Index>(order_.size()));
     correction_.setZero(3, chain_starts_.size() > 1 ? model.nodeCount() : 0);  // only a chain's solve reads it
     swept_chain_.assign(chain_starts_.size(), 0);
@@ -332,6 +335,15 @@ private:
     for (int i = 0; i < model.nodeCount(); ++i)
       if (model.isFree(i))
         state.velocity.col(i) = (state.position.col(i) - previous_.col(i)) * inverse_h;
+  }
+
+  /// The chain solver's buffers for the longest chain of chain_starts_.
+  void reserveChains()
+  {
+    std::size_t longest = 0;
+    for (std::size_t c = 1; c < chain_starts_.size(); ++c)
+      longest = std::max(longest, chain_starts_[c] - chain_starts_[c - 1]);
+    chains_.reserve(longest);
   }
 
   NodeArray previous_;

@@ -44,6 +44,7 @@ public:
     return static_cast<int>(pairs_.size()) - 1;
   }
   std::size_t pairCount() const { return pairs_.size(); }
+  const std::vector<std::pair<int, int>>& pairs() const { return pairs_; }
   /// Drops the pairs after the first `count` (those a kind added later and no longer needs).
   void truncatePairs(std::size_t count) { pairs_.resize(count); }
   /// Prepares the solves for the pattern over `nodes` nodes: the block-tridiagonal one where the pairs form

@@ -59,6 +59,8 @@ struct NodeHolds
   /// friction of its own inertia and weight pressing it on), taken into the first Newton step of its
   /// sub-step: x += W~ h^2 f with the rows' dlambda that answer it in the same linear solve.
   NodeArray push;
+
+  void carry(StateArchive& archive) { archive(kind, normal, slip, friction, push); }
 };
 
 /// One Newton step of XPBD on a chain, with the chain's geometric stiffness.

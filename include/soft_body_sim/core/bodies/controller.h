@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -29,6 +30,9 @@ public:
   /// A copy in the same state (its clock, its own dynamics' history): stepped as the original is, it
   /// gives the same bits.
   virtual std::unique_ptr<Controller> clone() const = 0;
+  /// Writes or reads what a clone copies but what the scene fixes (state_archive.h), into a controller
+  /// made for the same body.
+  virtual void carry(StateArchive& archive) = 0;
   /// Advances the procedural motion by dt [s] and writes the positions [m] and velocities [m/s] of its
   /// nodes into `state`; it may read any node (e.g. a root following a torso).
   virtual void step(double dt, State& state) = 0;

@@ -19,6 +19,7 @@
 
 #include "soft_body_sim/core/bodies/bezier.h"
 #include "soft_body_sim/core/scene_def.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -72,6 +73,8 @@ public:
 
   const Vec3& joint() const { return joint_; }
   const Vec3& leaf() const { return leaf_; }
+
+  void carry(StateArchive& archive) { archive(joint_, leaf_, joint_previous_, leaf_previous_); }
 
 private:
   LimbMotion motion_;

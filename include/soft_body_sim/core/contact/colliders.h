@@ -11,6 +11,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "soft_body_sim/core/state_archive.h"
+
 namespace soft_body_sim
 {
 /// A wall or floor: the half-space (x - point) . normal >= 0 is free space, nodes are pushed out of the
@@ -23,6 +25,8 @@ struct Plane
   double friction = 0.0;                              ///< Coulomb coefficient [-], >= 0
   std::string name{};  ///< names its wrench (World::colliderWrenches, about `point`); empty: none reported
   Eigen::Vector3d color = Eigen::Vector3d::Constant(0.8);  ///< rgb in [0, 1], as a camera sees it
+
+  void carry(StateArchive& archive) { archive(point, normal, restitution, friction, name, color); }
 };
 
 /// Where a rigid collider is and how it moves, and its surface. Its pose moves at constant `velocity`
@@ -39,6 +43,11 @@ struct ColliderPlacement
   double restitution = 0.0;  ///< normal speed kept after a bounce, in [0, 1]
   std::string frame;         ///< a tf frame the ROS node makes it follow (pose relative to it); empty = none
   Eigen::Vector3d color = Eigen::Vector3d::Constant(0.6);  ///< rgb in [0, 1], as rviz and a camera see it
+
+  void carry(StateArchive& archive)
+  {
+    archive(name, position, orientation, velocity, angular_velocity, friction, restitution, frame, color);
+  }
 };
 
 /// A ball of `radius` [m] about its origin.
@@ -46,6 +55,8 @@ struct Sphere
 {
   ColliderPlacement at;
   double radius = 0.1;  ///< [m], > 0
+
+  void carry(StateArchive& archive) { archive(at, radius); }
 };
 
 /// A segment of `length` [m] along its local z axis, centred on its origin, thickened by `radius` [m]
@@ -55,6 +66,8 @@ struct Capsule
   ColliderPlacement at;
   double radius = 0.05;  ///< [m], > 0
   double length = 0.5;   ///< [m] between the end centres, >= 0
+
+  void carry(StateArchive& archive) { archive(at, radius, length); }
 };
 
 /// A solid cylinder of `radius` [m] and `length` [m] along its local z axis, centred on its origin (flat
@@ -64,6 +77,8 @@ struct Cylinder
   ColliderPlacement at;
   double radius = 0.05;  ///< [m], > 0
   double length = 0.5;   ///< [m], > 0
+
+  void carry(StateArchive& archive) { archive(at, radius, length); }
 };
 
 /// A box of full extents `size` [m] along its local x, y, z, centred on its origin.
@@ -71,6 +86,8 @@ struct Box
 {
   ColliderPlacement at;
   Eigen::Vector3d size = Eigen::Vector3d::Constant(0.1);  ///< [m], each > 0
+
+  void carry(StateArchive& archive) { archive(at, size); }
 };
 
 struct TriangleMesh;
@@ -87,6 +104,9 @@ struct Mesh
   double voxel_size = 0.0;  ///< [m] edge of the distance field's voxels, > 0; 0 = defaultVoxelSize
   std::shared_ptr<const TriangleMesh> triangles;  ///< readTriangleMesh of the file, scale applied
   std::shared_ptr<const MeshField> field;  ///< built from `triangles` by buildMeshFields (makeColliderKinds)
+
+  /// The file, placement and scale; the triangles and field are made from them.
+  void carry(StateArchive& archive) { archive(at, uri, scale, voxel_size); }
 };
 
 /// Every collider of a scene, by kind. A scene without any has no contact stage at all.
@@ -98,6 +118,8 @@ struct Colliders
   std::vector<Box> boxes;
   std::vector<Cylinder> cylinders;
   std::vector<Mesh> meshes;
+
+  void carry(StateArchive& archive) { archive(planes, spheres, capsules, boxes, cylinders, meshes); }
 };
 
 /// Every shape's placement, in the order of Colliders' vectors (spheres, capsules, boxes, cylinders,

@@ -16,6 +16,7 @@
 #include "soft_body_sim/core/holding/reactions.h"
 #include "soft_body_sim/core/integrators/integrator.h"
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -69,6 +70,8 @@ struct RigidPose
 {
   Vec3 position = Vec3::Zero();
   Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();
+
+  void carry(StateArchive& archive) { archive(position, orientation); }
 };
 
 /// `local`, a pose in the frame that `frame` places, in the frame's parent (a tf child's pose composed with
@@ -105,6 +108,8 @@ struct ReceivedImpulse
   }
   /// Their mean force and torque over a step of dt [s].
   Wrench over(double dt) const { return Wrench{ linear / dt, angular / dt }; }
+
+  void carry(StateArchive& archive) { archive(linear, angular); }
 };
 
 /// One kind of collider, over all of its shapes in the model.
@@ -115,6 +120,8 @@ public:
   /// A copy with its shapes where they are, their goals and what they touch (a mesh's distance field is
   /// shared: it never changes).
   virtual std::unique_ptr<ColliderKind> clone() const = 0;
+  /// Writes or reads what a clone copies (state_archive.h), into a kind built from the same scene.
+  virtual void carry(StateArchive& archive) = 0;
   /// After a sub-step of h [s] that took the nodes from `start` [m] to state.position: moves its shapes
   /// by h and resolves the contacts of every free node with them. True if it touched any node (the
   /// integrators' caches of the state are then stale).
@@ -296,6 +303,15 @@ public:
   {
     for (const std::unique_ptr<ColliderKind>& kind : kinds_)
       kind->land();
+  }
+
+  /// Writes or reads what a copy copies but the paths (functions, not state: read, this stage keeps its
+  /// own) and what the scene fixes (the kinds and their shapes' numbering).
+  void carry(StateArchive& archive)
+  {
+    archive(dt_, start_);
+    for (const std::unique_ptr<ColliderKind>& kind : kinds_)
+      kind->carry(archive);
   }
 
 private:

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -37,6 +38,11 @@ public:
   /// gap and the largest radius together within the cell's width).
   template <typename Visit>
   void forEachNear(const Vec3& centre, double radius, double gap, Visit visit) const;
+
+  void carry(StateArchive& archive)
+  {
+    archive(cell_, coordinate_, start_, slot_of_, cursor_, place_, sorted_, x_, y_, z_, r_);
+  }
 
 private:
   std::int64_t slot(std::int64_t i, std::int64_t j, std::int64_t k) const;
@@ -135,6 +141,14 @@ public:
   /// How many times the candidate pairs have been searched: once per Verlet list (kSkinRadii).
   std::size_t searches() const { return searches_; }
 
+  /// Writes or reads the Verlet lists and what the passes keep from sub-step to sub-step
+  /// (state_archive.h); the links, faces and their radii are the scene's.
+  void carry(StateArchive& archive)
+  {
+    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, tick_,
+            face_centre_, face_extent_, face_grid_, face_candidates_, near_faces_);
+  }
+
   /// Two links of one body whose first nodes are this many places apart or fewer never collide: a rope
   /// bent back on itself within a few links touches itself at its joints already.
   static constexpr int kSkippedLinks = 2;
@@ -220,6 +234,8 @@ private:
   {
     std::uint32_t s, t;  ///< segment indices, s < t
     double distance;
+
+    void carry(StateArchive& archive) { archive(s, t, distance); }
   };
   /// The pairs that may touch, ordered by s and then t: the order the passes take the touching ones in,
   /// whatever the search (its grid, its skin) or how often it runs, so that none of that changes a bit.
@@ -236,6 +252,8 @@ private:
   {
     double p, q, distance, ka, kb, kc, kd, weight;
     Vec3 n;
+
+    void carry(StateArchive& archive) { archive(p, q, distance, ka, kb, kc, kd, weight, n); }
   };
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
@@ -246,6 +264,8 @@ private:
     Contact contact{};   ///< its contact when last looked at (at tick `seen`)
     bool valid = false;  ///< that contact has a direction and a free node
     std::uint64_t seen = 0;
+
+    void carry(StateArchive& archive) { archive(s, t, push, stop, contact, valid, seen); }
   };
   std::vector<NearPair> near_;
   /// per node (global index): the tick_ of the last push that moved it
@@ -271,6 +291,8 @@ private:
     double side;
     double push;
     double stop;
+
+    void carry(StateArchive& archive) { archive(node, face, side, push, stop); }
   };
   std::vector<NearFace> near_faces_;
 };

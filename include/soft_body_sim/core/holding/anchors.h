@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -58,6 +59,10 @@ public:
   void removed(std::size_t k);
   /// True for an anchor made by attach (after the scene's).
   bool isAttached(int k) const;
+
+  /// Writes or reads the goals and turns (state_archive.h). Paths are functions, not state: read, the
+  /// scene's anchors keep this set's paths and the attached ones have none.
+  void carry(StateArchive& archive);
 
 private:
   std::vector<std::optional<Vec3>> goals_;  ///< per anchor: where to be at the end of the next step

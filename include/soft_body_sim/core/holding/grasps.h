@@ -13,6 +13,7 @@
 #include "soft_body_sim/core/contact/contact_stage.h"
 #include "soft_body_sim/core/model.h"
 #include "soft_body_sim/core/holding/reactions.h"
+#include "soft_body_sim/core/state_archive.h"
 
 namespace soft_body_sim
 {
@@ -31,6 +32,8 @@ struct GraspedNodes
   /// turn with its frame.
   std::vector<int> rod_stations;
   double max_force = std::numeric_limits<double>::infinity();  ///< [N]: above it the grasp slips
+
+  void carry(StateArchive& archive) { archive(name, body, nodes, offsets, pose, rod_stations, max_force); }
 };
 
 /// A grasp that let go because its force exceeded its max_force.
@@ -43,6 +46,8 @@ struct GraspSlip
   double max_force = 0.0;  ///< [N]
   /// One line for a log: "grasp 'gripper' on body 'rope' slipped at t = 1.25 s: force 12.3 N > max_force 10 N".
   std::string describe() const;
+
+  void carry(StateArchive& archive) { archive(time, grasp, body, force, max_force); }
 };
 
 class GraspSet
@@ -84,6 +89,10 @@ public:
   std::vector<Wrench> wrenches(const Model& model, const State& state, const NodeArray& pull) const;
   /// True if some grasp has a force limit (its wrench is then needed every step).
   bool limited() const;
+
+  /// Writes or reads the grasps and their goals (state_archive.h). Paths are functions, not state: read,
+  /// a grasp keeps the path this set's grasp of its name had.
+  void carry(StateArchive& archive);
 
 private:
   /// The pose at fraction s in [0, 1] of grasp k's way to its goal.

@@ -37,6 +37,8 @@ struct NodeContact
   double friction = 0.0;  ///< Coulomb coefficient [-]
   double depth = 0.0;     ///< [m] how far the node is inside its contact radius (< 0: that far outside it)
   int collider = -1;      ///< which collider it is, for ContactQuery::receive (-1: none)
+
+  void carry(StateArchive& archive) { archive(normal, velocity, friction, depth, collider); }
 };
 
 /// A point of a contact triangle that a collider's edge, corner or thin part comes near between the
@@ -49,6 +51,8 @@ struct FaceContact
   /// the point is inside the triangle's thickness from the shape at the sub-step's end (< 0: outside)
   NodeContact contact;
   std::size_t feature = 0;  ///< which of the collider's features (with the triangle and the collider, the contact's name)
+
+  void carry(StateArchive& archive) { archive(triangle, weight, contact, feature); }
 };
 
 /// The colliders as a solve can ask about them (the contact stage, contact_stage.h).
@@ -90,6 +94,9 @@ public:
   /// Makes this one a copy of `other` (as clone), reusing its buffers; false (and unchanged) if `other` is
   /// of another kind.
   virtual bool assign(const Integrator& other) = 0;
+  /// Writes or reads what a clone carries (state_archive.h): what the next steps depend on, not the
+  /// scratch a step makes anew.
+  virtual void carry(StateArchive& archive, const Model& model) = 0;
   /// Advances `state` by h [s]. Pinned nodes (inverse mass 0) are never moved: their position and
   /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
   virtual void step(const Model& model, State& state, double h, int iterations) = 0;

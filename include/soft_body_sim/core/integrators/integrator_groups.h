@@ -50,6 +50,11 @@ public:
   /// The model was changed: they drop what they cached from it, and the groups are made again.
   void modelChanged();
 
+  /// Writes or reads which body each integrator steps and each integrator's carried state
+  /// (state_archive.h); `model` is the world's, read already. Read, the groups are made again from it as
+  /// they were made from it (a change of the model since would have asked for that anyway).
+  void carry(StateArchive& archive, const Model& model);
+
 private:
   struct Group
   {

@@ -40,6 +40,8 @@ class ColliderHolds
 public:
   /// The nodes of `model`'s solids and contact triangles, no force known on any.
   void analyze(const Model& model);
+  /// Writes or reads the holds and their forces (state_archive.h); read after analyze.
+  void carry(StateArchive& archive) { archive(hold_force_, holds_); }
   /// Finds the holds against `contacts` at the step's first Newton iteration and keeps them through the
   /// others; adds their blocks to the system's diagonal (after every element's: b is the node's block) and
   /// their push and friction to its rhs.
@@ -68,6 +70,11 @@ private:
     double scaled;        ///< h^2 k [kg] in this iteration
     double damping;       ///< c [kg/s] of its friction in this iteration (frictionDamping)
     Vec3 slip;            ///< v_t [m/s] that friction damped in this iteration
+
+    void carry(StateArchive& archive)
+    {
+      archive(node, contact, found_at, found_depth, depth, scaled, damping, slip);
+    }
   };
   void find(const NewtonPoint& point, const ContactQuery& contacts);
   /// k (d - h n . dv) [N]: the force `hold` took in the Newton iteration that solved dv (> 0 pushing).

@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 
@@ -51,6 +53,28 @@ public:
   /// Between steps (contacts_ is null then): the pattern, the holds' forces, everything carried.
   std::unique_ptr<Integrator> clone() const override { return std::make_unique<ImplicitEuler>(*this); }
   bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
+  /// The pattern as it grew (the elements' pairs, then the holds' as they joined, which fix the
+  /// factorisation's order and so its round-off) and the holds; the analysis and the slots are made again
+  /// from them and the model.
+  void carry(StateArchive& archive, const Model& model) override
+  {
+    ForceBasedIntegrator::carry(archive, model);
+    std::vector<std::pair<int, int>> pairs = system_.pairs();
+    archive(analyzed_, pairs);
+    if (archive.reading() && analyzed_)
+    {
+      analyze(model);
+      const std::vector<std::pair<int, int>>& elements = system_.pairs();
+      const std::size_t element_pairs = elements.size();
+      if (pairs.size() < element_pairs || !std::equal(elements.begin(), elements.end(), pairs.begin()))
+        throw std::invalid_argument("snapshot bytes: implicit_euler's pattern is not this model's");
+      for (std::size_t k = element_pairs; k < pairs.size(); ++k)
+        system_.addPair(pairs[k].first, pairs[k].second);
+      if (pairs.size() > element_pairs)
+        system_.analyzeSparse();
+    }
+    archive(collider_holds_, surface_holds_);
+  }
 
   void modelChanged() override { analyzed_ = false; }
 

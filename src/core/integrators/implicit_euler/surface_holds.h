@@ -57,6 +57,13 @@ public:
   /// present() is false and every step has no holds). Call after every element kind has placed its pairs in
   /// `system`: the holds' pairs come after them.
   void analyze(const Model& model, const BlockSystem& system);
+  /// Writes or reads what a step leaves for the next (state_archive.h): the holds and their forces, the
+  /// pattern's slots; read after analyze, which makes the rest from the model.
+  void carry(StateArchive& archive)
+  {
+    archive(touches_, holds_, hold_force_, edge_force_, element_pairs_, slot_of_pair_, slots_, sample_force_,
+            faces_found_, held_faces_, face_force_);
+  }
   /// Whether the model can have surface holds at all.
   bool present() const { return contacts_.has_value() || !sample_force_.empty() || faces_; }
   /// Whether the Newton iteration being assembled has any.
@@ -126,6 +133,10 @@ private:
 
     /// A triangle's point held on a collider (a sample or a face): the collider in p's place.
     bool onCollider() const { return sample >= 0 || face >= 0; }
+    void carry(StateArchive& archive)
+    {
+      archive(touch, nodes, depth, scaled, block, sample, face, contact, damping, slip);
+    }
   };
   /// A face contact's name from step to step: its triangle, collider and the collider's feature.
   using FaceKey = std::tuple<std::size_t, int, std::size_t>;
