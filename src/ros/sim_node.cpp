@@ -1,6 +1,10 @@
 #include "soft_body_sim/ros/sim_node.h"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 
 #include <ros/names.h>
 #include <std_msgs/Time.h>
@@ -8,6 +12,7 @@
 #include "ros/node_parameters.h"
 #include "soft_body_sim/SimState.h"
 #include "soft_body_sim/core/contact/mesh_field.h"
+#include "soft_body_sim/core/format_number.h"
 #include "soft_body_sim/ros/robot_colliders.h"
 #include "soft_body_sim/scene/scene_loader.h"
 
@@ -82,6 +87,8 @@ void SimNode::initialize()
   detach_service_ = private_nh_.advertiseService("detach", &SimNode::onDetach, this);
   grasp_service_ = private_nh_.advertiseService("grasp", &SimNode::onGrasp, this);
   release_service_ = private_nh_.advertiseService("release", &SimNode::onRelease, this);
+  save_state_service_ = private_nh_.advertiseService("save_state", &SimNode::onSaveState, this);
+  load_state_service_ = private_nh_.advertiseService("load_state", &SimNode::onLoadState, this);
   timer_ = nh_.createTimer(ros::Duration(1.0 / rate_), &SimNode::onTimer, this);
   ROS_INFO("%s: scene %s, %d nodes in %zu bodies, %s at dt = %g s, publishing at %g Hz in frame '%s'", name_.c_str(),
            scene_path_.c_str(), world_->model().nodeCount(), world_->model().bodies.size(),
@@ -114,20 +121,41 @@ void SimNode::addRobotColliders()
 void SimNode::buildWorldFromScene()
 {
   world_ = std::make_unique<World>(buildWorld(scene_));
-  next_state_time_ = world_->time();
   // Live tuning outlives a reset: the sliders keep showing what is in force.
   if (sim_reconfigure_)
     applySimConfig(sim_reconfigure_->config());
   for (const auto& [body, server] : body_reconfigure_)
     applyBodyConfig(body, server->config());
+  followFrames();
+  restartAtWorldTime();
+}
+
+void SimNode::followFrames()
+{
   max_steps_per_tick_ = std::max(1L, std::lround(std::ceil(2.0 / (rate_ * world_->settings().dt))));
   const std::vector<Anchor>& anchors = world_->model().anchors;
   for (std::size_t k = 0; k < anchors.size(); ++k)
+  {
+    const int anchor = static_cast<int>(k);
     if (!anchors[k].frame.empty())
-      followFrame(static_cast<int>(k), anchors[k].frame);
+      followFrame(anchor, anchors[k].frame);
+    else if (world_->isAttached(anchor))
+      followFrame(anchor, anchors[k].name);  // ~attach names the anchor by its frame
+  }
   for (const ColliderPlacement* at : placements(world_->model().colliders))
     if (!at->frame.empty())
       followFrame(*at);
+  for (const GraspedNodes& grasp : world_->grasps())
+  {
+    const std::string frame = grasp.name;
+    const auto glide = std::make_shared<FrameGlide>(FrameGlide{ InputGlide(), pauses_ });
+    world_->followGraspPath(frame, [this, frame, glide](double t) { return followedPose(frame, t, *glide); });
+  }
+}
+
+void SimNode::restartAtWorldTime()
+{
+  next_state_time_ = world_->time();
   targets_.clear();
   inputs_.clear();
   glides_.clear();
@@ -389,6 +417,87 @@ bool SimNode::onReset(std_srvs::Empty::Request&, std_srvs::Empty::Response&)
     epoch_ = last_tick_;
   slips_.clear();
   ROS_INFO("%s: reset to the initial scene (attached and grasped nodes released; live tuning kept)", name_.c_str());
+  return true;
+}
+
+bool SimNode::onSaveState(StateFile::Request& request, StateFile::Response& response)
+{
+  response.time = world_->time();
+  const std::string bytes = world_->snapshot().toBytes();
+  // Into a file beside it first, then renamed over it: a reader never sees half a snapshot.
+  const std::string partial = request.path + ".partial";
+  {
+    std::ofstream file(partial, std::ios::binary | std::ios::trunc);
+    file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    file.close();
+    std::error_code error;
+    if (!file || (std::filesystem::rename(partial, request.path, error), error))
+    {
+      std::filesystem::remove(partial, error);
+      response.success = false;
+      response.message = "cannot write '" + request.path + "': " + std::strerror(errno);
+      ROS_WARN("%s: save_state refused: %s", name_.c_str(), response.message.c_str());
+      return true;
+    }
+  }
+  response.success = true;
+  response.message = "saved t = " + formatNumber(response.time) + " s (" + std::to_string(bytes.size()) +
+                     " bytes) to '" + request.path + "'";
+  ROS_INFO("%s: %s", name_.c_str(), response.message.c_str());
+  return true;
+}
+
+bool SimNode::onLoadState(StateFile::Request& request, StateFile::Response& response)
+{
+  const auto refuse = [&](const std::string& why) {
+    response.success = false;
+    response.time = world_->time();
+    response.message = "'" + request.path + "': " + why;
+    ROS_WARN("%s: load_state refused: %s", name_.c_str(), response.message.c_str());
+    return true;
+  };
+  std::error_code error;
+  if (!std::filesystem::is_regular_file(request.path, error))
+    return refuse(error ? error.message() : "not a regular file");
+  const std::uintmax_t size = std::filesystem::file_size(request.path, error);
+  if (error)
+    return refuse(error.message());
+  if (size > kMaxStateFileBytes)
+    return refuse(std::to_string(size) + " bytes, more than the " + std::to_string(kMaxStateFileBytes) +
+                  " a snapshot of the largest scene takes");
+  std::ifstream file(request.path, std::ios::binary);
+  std::string bytes(static_cast<std::size_t>(size), '\0');
+  if (!file.read(bytes.data(), static_cast<std::streamsize>(size)))
+    return refuse(std::string("cannot read it: ") + std::strerror(errno));
+  try
+  {
+    world_->restore(WorldSnapshot::fromBytes(std::move(bytes)));
+  }
+  catch (const std::invalid_argument& e)
+  {
+    return refuse(e.what());
+  }
+  // Simulated time goes on from the moment, at the ROS time of now.
+  if (started_)
+    epoch_ = last_tick_ - ros::Duration(world_->time());
+  slips_.clear();
+  followFrames();
+  restartAtWorldTime();
+  if (sim_reconfigure_)
+    sim_reconfigure_->update(RosConverter::toSimConfig(*world_));
+  for (const auto& [body, server] : body_reconfigure_)
+  {
+    BodyConfig config = server->config();
+    const BodyScaling scaling = world_->bodyScaling(body);
+    config.stiffness_scale = scaling.stiffness;
+    config.damping_scale = scaling.damping;
+    config.pressure_scale = scaling.pressure;
+    server->update(config);
+  }
+  response.success = true;
+  response.time = world_->time();
+  response.message = "loaded t = " + formatNumber(response.time) + " s from '" + request.path + "'";
+  ROS_INFO("%s: %s", name_.c_str(), response.message.c_str());
   return true;
 }
 

@@ -29,6 +29,7 @@
 #include "soft_body_sim/BodyConfig.h"
 #include "soft_body_sim/Detach.h"
 #include "soft_body_sim/Grasp.h"
+#include "soft_body_sim/StateFile.h"
 #include "soft_body_sim/SimConfig.h"
 #include "soft_body_sim/core/scene_def.h"
 #include "soft_body_sim/ros/anchor_handles.h"
@@ -40,6 +41,11 @@
 
 namespace soft_body_sim
 {
+/// The largest file ~load_state reads [bytes], refused by its size before it is read: a snapshot of a
+/// scene of kMaxSceneNodes nodes under implicit Euler with self-contact, at the ~1 kB a node that a cloth's
+/// takes (docs/physics.md, "Snapshots and clones"), with margin.
+constexpr std::uintmax_t kMaxStateFileBytes = std::uintmax_t{ 4 } << 30;
+
 class SimNode
 {
 public:
@@ -67,6 +73,12 @@ private:
   void printStatus(const ros::Time& now);
   /// Builds the world from the scene and re-applies the live tuning and the tf-following anchors.
   void buildWorldFromScene();
+  /// Every anchor, collider and grasp that follows a tf frame (the scene's, ~attach's, ~grasp's) follows it
+  /// afresh.
+  void followFrames();
+  /// What the node keeps of the world's moment starts again from the world's time: the state timer, the
+  /// inputs waiting for their stamps, the glides, the cameras' frames.
+  void restartAtWorldTime();
 
   // --- inputs (sim_node_inputs.cpp)
   /// ~max_input_age [s], ~max_input_lead [s] and ~max_held_inputs (see InputLimits); throws, naming the
@@ -154,6 +166,11 @@ private:
 
   bool onReset(std_srvs::Empty::Request& request, std_srvs::Empty::Response& response);
   bool onPause(std_srvs::SetBool::Request& request, std_srvs::SetBool::Response& response);
+  /// ~save_state: the world's snapshot (WorldSnapshot::toBytes) into request.path, written whole or not at all.
+  bool onSaveState(StateFile::Request& request, StateFile::Response& response);
+  /// ~load_state: the world back to the moment of request.path, a ~save_state file of this scene; simulated
+  /// time goes on from that moment, ROS time from now. The live tuning becomes the moment's.
+  bool onLoadState(StateFile::Request& request, StateFile::Response& response);
 
   ros::NodeHandle nh_;
   ros::NodeHandle private_nh_;
@@ -182,6 +199,8 @@ private:
   ros::ServiceServer detach_service_;
   ros::ServiceServer grasp_service_;
   ros::ServiceServer release_service_;
+  ros::ServiceServer save_state_service_;
+  ros::ServiceServer load_state_service_;
   std::map<std::string, ros::Publisher> wrench_publishers_;  ///< by topic, per anchor and grasp
   std::map<std::string, ros::Publisher> collider_wrench_publishers_;  ///< by collider name
   ros::Timer timer_;
