@@ -32,9 +32,10 @@
 // surface_samples cost per step against its nodes alone (which let the rod in).
 // BM_LoadedRope/<pinned|over_capsule>: a rope with loads at its ends (xpbd chains) pinned where it would
 // touch a capsule, and the same rope over the capsule with friction, its contacts inside the chains' solve.
-// BM_Snapshot/<rope_51|demo>/<step|snapshot_restore>: a 51-node rope (implicit_euler at 1/60 s, gravity)
-// and config/scenes/demo.yaml 2 s in: one step against one World::snapshot (into the last snapshot's
-// buffers) plus World::restore.
+// BM_Snapshot/<rope_51|demo>/<step|snapshot_restore|bytes>: a 51-node rope (implicit_euler at 1/60 s,
+// gravity) and config/scenes/demo.yaml 2 s in: one step against one World::snapshot (into the last
+// snapshot's buffers) plus World::restore, and against a snapshot to bytes and back (toBytes, fromBytes,
+// restore), as a file or another process takes it.
 // BM_CameraFrame/<render|messages>: a 640 x 480 frame of config/scenes/demo.yaml's camera 2 s into the
 // scene (sensing/depth_camera.h): the ray casting alone, and with the node's five messages made from it
 // (colour, depth in millimetres and in metres, mask, organised cloud: RosConverter); items = pixels.
@@ -668,18 +669,27 @@ World snapshotWorld(bool demo)
   return world;
 }
 
-void BM_Snapshot(benchmark::State& bench, bool demo, bool snapshot_restore)
+enum class SnapshotWork
+{
+  Step,
+  SnapshotRestore,
+  Bytes
+};
+
+void BM_Snapshot(benchmark::State& bench, bool demo, SnapshotWork work)
 {
   World world = snapshotWorld(demo);
   const WorldSnapshot moment = world.snapshot();
   WorldSnapshot now = world.snapshot();
   for (auto _ : bench)
   {
-    if (snapshot_restore)
+    if (work == SnapshotWork::SnapshotRestore)
     {
       world.snapshot(now);  // as a planner takes one each cycle, into the last one's buffers
       world.restore(now);
     }
+    else if (work == SnapshotWork::Bytes)
+      world.restore(WorldSnapshot::fromBytes(world.snapshot().toBytes()));
     else
     {
       world.step();
@@ -773,10 +783,14 @@ BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_2mm, 0.002)->Unit(benchmark::kMill
 BENCHMARK_CAPTURE(BM_ThinRodPressing, samples_1mm, 0.001)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_LoadedRope, pinned, false);
 BENCHMARK_CAPTURE(BM_LoadedRope, over_capsule, true);
-BENCHMARK_CAPTURE(BM_Snapshot, rope_51/step, false, false)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Snapshot, rope_51/snapshot_restore, false, true)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Snapshot, demo/step, true, false)->Unit(benchmark::kMicrosecond);
-BENCHMARK_CAPTURE(BM_Snapshot, demo/snapshot_restore, true, true)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, rope_51/step, false, SnapshotWork::Step)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, rope_51/snapshot_restore, false, SnapshotWork::SnapshotRestore)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, rope_51/bytes, false, SnapshotWork::Bytes)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, demo/step, true, SnapshotWork::Step)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, demo/snapshot_restore, true, SnapshotWork::SnapshotRestore)
+    ->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Snapshot, demo/bytes, true, SnapshotWork::Bytes)->Unit(benchmark::kMicrosecond);
 BENCHMARK_CAPTURE(BM_CameraFrame, render, false)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_CameraFrame, messages, true)->Unit(benchmark::kMillisecond);
 
