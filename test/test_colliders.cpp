@@ -336,6 +336,29 @@ TEST(ColliderPath, APathDrivenColliderLandsOnItsPathAndDragsByItsVelocity)
   EXPECT_NEAR(poses[0].orientation.angularDistance(expected), 0.0, 1e-9);
 }
 
+// A collider moved once (World::moveCollider, as Python's move_collider) is at its pose at the step's end and
+// holds still there after it, instead of drifting on at the velocity of its one move; a node resting on it
+// is dragged by that move's velocity while it lasts, and comes to rest again after.
+TEST(ColliderPath, AColliderMovedOnceGlidesToItsPoseInOneStepAndStaysThere)
+{
+  const double mu = 0.4, dt = 1.0 / 240.0;
+  SceneDef scene = nodeOnTiltedBox(IntegratorType::SemiImplicitEuler, 0.0, mu, dt);
+  World world = buildWorld(scene);
+  const RigidPose goal{ Vec3(0.002, 0, 0), Eigen::Quaterniond(Eigen::AngleAxisd(0.01, Vec3::UnitZ())) };
+  ASSERT_TRUE(world.moveCollider("ramp", goal));
+  EXPECT_FALSE(world.moveCollider("nothing", goal));
+  world.step();
+  EXPECT_GT(world.state().velocity(0, 0), 0.0);  // dragged by the box's 0.48 m/s during the step
+  for (int n = 0; n < 120; ++n)
+  {
+    const ColliderPose pose = world.colliderPoses().at(0);
+    EXPECT_EQ(pose.position, goal.position);
+    EXPECT_EQ(pose.orientation.coeffs(), goal.orientation.normalized().coeffs());
+    world.step();
+  }
+  EXPECT_NEAR(world.state().velocity(0, 0), 0.0, 1e-12);
+}
+
 // --- a rope's segments ----------------------------------------------------------------------------------
 
 /// The distance [m] between segments p0-p1 and q0-q1, by brute force over 201 points of each.

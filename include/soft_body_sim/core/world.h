@@ -159,6 +159,10 @@ public:
   /// velocity over the step (which friction sees); where the path has no pose it holds still. False if there
   /// is none of that name.
   bool followColliderPath(const std::string& name, ColliderPath path) { return contacts_.followPath(name, std::move(path)); }
+  /// Collider `name` moves to `pose` during the next step, at constant linear and angular velocity (which
+  /// friction sees), and holds still there after it. The latest call before a step wins; a path the collider
+  /// follows overrides it. False if there is none of that name.
+  bool moveCollider(const std::string& name, const RigidPose& pose) { return contacts_.setGoal(name, pose, settings_.dt); }
 
   /// Sets a node's position [m] and velocity [m/s] directly.
   void setNode(int node, const Vec3& position, const Vec3& velocity);

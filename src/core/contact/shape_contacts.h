@@ -355,6 +355,9 @@ public:
       {
         shapes_[k].at.position = goals_[k]->position;
         shapes_[k].at.orientation = goals_[k]->orientation;
+        // Arrived: it holds still unless a new goal (a path's, World::moveCollider's) moves it on.
+        shapes_[k].at.velocity.setZero();
+        shapes_[k].at.angular_velocity.setZero();
         goals_[k].reset();
         placed_[k] = 1;
       }
