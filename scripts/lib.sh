@@ -18,6 +18,7 @@ PACKAGES=(
   libeigen3-dev libyaml-cpp-dev libopenvdb-dev libassimp-dev libroslib-dev libembree-dev libpng-dev
   tetgen
   googletest libgtest-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest
   clang libclang-rt-14-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libinteractive-markers-dev libdiagnostic-updater-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev
