@@ -1,0 +1,60 @@
+"""A Python World of a scene steps to the same bits as the headless `simulate` of the same scene: the same
+loader (package:// meshes, `dt: auto`), the same world. simulate writes 17 significant digits, which read back
+as the very doubles it printed."""
+import csv
+import subprocess
+
+import pytest
+
+from conftest import SCENES, same_bits
+from soft_body_sim import sim
+
+# A rope falling onto the example mesh, named by package://, at the step `dt: auto` chooses.
+AUTO_DT_MESH_SCENE = """
+physics: {integrator: semi_implicit_euler, dt: auto}
+colliders:
+  - {name: part, shape: mesh, mesh: package://soft_body_sim/config/meshes/part.stl, position: [0.5, 0.0, 0.85]}
+bodies:
+  - {name: rope, type: rope, nodes: 15, from: [0.0, 0.0, 1.0], to: [1.0, 0.0, 1.0], mass: 0.1, stiffness: 500.0,
+     damping: 0.01, radius: 0.01, pinned: [0], anchors: [{name: end, node: 0}]}
+"""
+
+
+def last_rows(path, columns):
+    """The rows of a simulate CSV at its last time, by their leading key columns (strings) after t."""
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))[1:]
+    last = max(float(row[0]) for row in rows)
+    return float(rows[-1][0]), {tuple(row[1:columns]): [float(x) for x in row[columns:]]
+                                for row in rows if float(row[0]) == last}
+
+
+@pytest.mark.parametrize("scene", [str(SCENES / "rope.yaml"), str(SCENES / "cloth.yaml"), "auto_dt_mesh"])
+def test_positions_tensions_and_wrenches_equal_simulate_to_the_bit(scene, simulate, tmp_path):
+    if scene == "auto_dt_mesh":
+        scene = str(tmp_path / "auto_dt_mesh.yaml")
+        with open(scene, "w") as f:
+            f.write(AUTO_DT_MESH_SCENE)
+    duration = 0.5
+    out = {name: str(tmp_path / (name + ".csv")) for name in ("csv", "tensions", "forces")}
+    subprocess.run([simulate, "--scene", scene, "--duration", str(duration)] +
+                   [arg for name, path in out.items() for arg in ("--" + name, path)], check=True)
+
+    w = sim.World(scene)
+    w.step(round(duration / w.dt))
+
+    t, positions = last_rows(out["csv"], 3)
+    assert t == w.time
+    for body in w.bodies:
+        expected = [positions[(body, str(k))] for k in range(w.positions(body).shape[0])]
+        assert same_bits(w.positions(body), expected), body
+    _, tensions = last_rows(out["tensions"], 6)
+    for body in w.bodies:
+        # simulate's rows per body: its springs, then its constraints, each in order, as tensions() lists them.
+        expected = [tension for (name, kind, index, a, b), [tension] in tensions.items() if name == body]
+        assert same_bits(w.tensions(body), expected), body
+    _, forces = last_rows(out["forces"], 3)
+    for body in w.bodies:
+        for anchor in w.anchors(body):
+            force, torque = w.wrench(body, anchor)
+            assert same_bits(force, forces[(body, anchor)][:3]) and same_bits(torque, forces[(body, anchor)][3:])
