@@ -29,10 +29,11 @@ def last_rows(path, columns):
                                 for row in rows if float(row[0]) == last}
 
 
-@pytest.mark.parametrize("scene", [str(SCENES / "rope.yaml"), str(SCENES / "cloth.yaml"), "auto_dt_mesh"])
-def test_positions_tensions_and_wrenches_equal_simulate_to_the_bit(scene, simulate, tmp_path):
-    if scene == "auto_dt_mesh":
-        scene = str(tmp_path / "auto_dt_mesh.yaml")
+@pytest.mark.parametrize("name", ["rope.yaml", "cloth.yaml", "auto_dt_mesh.yaml"])
+def test_positions_tensions_and_wrenches_equal_simulate_to_the_bit(name, simulate, tmp_path):
+    scene = str(SCENES / name)
+    if name == "auto_dt_mesh.yaml":
+        scene = str(tmp_path / name)
         with open(scene, "w") as f:
             f.write(AUTO_DT_MESH_SCENE)
     duration = 0.5
