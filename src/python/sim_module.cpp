@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <memory>
 #include <string>
@@ -162,6 +163,15 @@ py::array_t<double> rollouts(const PythonWorld& w, const std::string& holder_nam
 
 py::object pathString(const py::object& path) { return py::module_::import("os").attr("fspath")(path); }
 
+/// WorldSnapshot::fromBytes of any bytes-like object (bytes, bytearray, memoryview).
+WorldSnapshot snapshotOfBytes(const py::object& data)
+{
+  const auto bytes = py::reinterpret_steal<py::bytes>(PyBytes_FromObject(data.ptr()));
+  if (!bytes)
+    throw py::error_already_set();  // a TypeError naming what is not bytes-like
+  return WorldSnapshot::fromBytes(static_cast<std::string>(bytes));
+}
+
 }  // namespace
 }  // namespace soft_body_sim::python
 
@@ -208,9 +218,20 @@ class UnknownName(KeyError):
       .def("__str__", &DivergenceEvent::describe)
       .def("__repr__", [](const DivergenceEvent& e) { return "<DivergenceEvent " + e.describe() + ">"; });
 
-  py::class_<WorldSnapshot>(m, "Snapshot", "A moment of a world (World.snapshot), to go back to with World.restore.")
+  py::class_<WorldSnapshot>(m, "Snapshot",
+                            "A moment of a world (World.snapshot), to go back to with World.restore; bytes "
+                            "(to_bytes, from_bytes) and pickle carry it to a file or another process.")
       .def_property_readonly("time", &WorldSnapshot::time, "[s] the world's simulated time then")
-      .def_property_readonly("step_count", &WorldSnapshot::stepCount);
+      .def_property_readonly("step_count", &WorldSnapshot::stepCount)
+      .def("to_bytes", [](const WorldSnapshot& s) { return py::bytes(s.toBytes()); },
+           "The snapshot as bytes: a versioned header with the scene's fingerprint, then every value of it.")
+      .def_static("from_bytes", &snapshotOfBytes, py::arg("data"),
+                  "A snapshot of to_bytes' bytes (or a bytearray, a memoryview), to restore into a world of the "
+                  "same scene; ValueError, saying why, for bytes that are no snapshot, damaged or cut short.")
+      .def("__copy__", [](const WorldSnapshot& s) { return s; })
+      .def("__deepcopy__", [](const WorldSnapshot& s, const py::dict&) { return s; }, py::arg("memo"))
+      .def(py::pickle([](const WorldSnapshot& s) { return py::make_tuple(py::bytes(s.toBytes())); },
+                      [](const py::tuple& state) { return snapshotOfBytes(state[0]); }));
 
   py::class_<PythonWorld>(m, "World",
                           "A running simulation of a scene file: the same loader, messages and world as `simulate`.")
@@ -428,7 +449,23 @@ class UnknownName(KeyError):
            "Back to the snapshot's moment; ValueError, naming both, for a snapshot of another scene.")
       .def(
           "clone", [](const PythonWorld& w) { return std::make_unique<PythonWorld>(w); },
-          "A copy that, given the same inputs, steps on to the same bits.")
+          "A copy that, given the same inputs, steps on to the same bits (copy.copy and copy.deepcopy too).")
+      .def("__copy__", [](const PythonWorld& w) { return std::make_unique<PythonWorld>(w); })
+      .def(
+          "__deepcopy__", [](const PythonWorld& w, const py::dict&) { return std::make_unique<PythonWorld>(w); },
+          py::arg("memo"))
+      // Pickled as its scene file's absolute path and a snapshot's bytes: unpickling loads the file again
+      // (refused, naming both scenes, if it changed) and restores the moment into it.
+      .def(py::pickle(
+          [](const PythonWorld& w) {
+            const WorldSnapshot now = w.read([](const World& world) { return world.snapshot(); });
+            return py::make_tuple(std::filesystem::absolute(w.scene()).string(), py::bytes(now.toBytes()));
+          },
+          [](const py::tuple& state) {
+            auto w = std::make_unique<PythonWorld>(state[0].cast<std::string>());
+            w->restore(snapshotOfBytes(state[1]));
+            return w;
+          }))
       .def("__repr__", [](const PythonWorld& w) {
         return w.read([&](const World& world) {
           std::string bodies;

@@ -1,6 +1,9 @@
-"""A clone, and a world restored to a snapshot (its own or another world's of the same scene), given the same
-inputs, step on to the same bits as the world that went on uninterrupted."""
+"""A clone, and a world restored to a snapshot (its own or another world's of the same scene, or one that went
+through bytes or pickle), given the same inputs, step on to the same bits as the world that went on
+uninterrupted."""
+import copy
 import math
+import pickle
 
 import numpy as np
 
@@ -36,11 +39,19 @@ def test_clone_and_restored_snapshots_continue_to_the_same_bits():
     other = sim.World(str(SCENES / "demo.yaml"))
     other.step(7)  # elsewhere in its own run: restore replaces all of it
 
+    pickled = pickle.dumps(w)  # its scene file's path and the moment's bytes
+    copied = copy.deepcopy(w)
+    data = moment.to_bytes()
+
     expected = drive(w, STEPS)
     assert moment.time == 30 * w.dt and moment.step_count == 30
     other.restore(moment)
+    from_bytes = sim.World(SCENES / "demo.yaml")
+    from_bytes.restore(sim.Snapshot.from_bytes(bytearray(data)))
+    from_pickle = sim.World(SCENES / "demo.yaml")
+    from_pickle.restore(pickle.loads(pickle.dumps(moment)))
     w.restore(moment)
-    for continued in (clone, other, w):
+    for continued in (clone, copied, other, from_bytes, from_pickle, pickle.loads(pickled), w):
         got = drive(continued, STEPS)
         assert all(same_bits(a, b) for a, b in zip(got[:2], expected[:2])) and got[2] == expected[2]
 

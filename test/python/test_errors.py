@@ -1,6 +1,8 @@
 """Bad input is a Python exception that says what is wrong, never a crash: an unknown name a KeyError naming
 the known ones, a malformed or non-finite array a ValueError, a scene the loader refuses sim.SceneError (a
 ValueError) with the loader's line, another scene's snapshot a ValueError naming both scenes."""
+import pickle
+
 import numpy as np
 import pytest
 
@@ -113,6 +115,28 @@ def test_goals_that_are_not_finite_or_no_orientation_are_named(rope):
 
 def test_a_snapshot_of_another_scene_is_refused_naming_both(rope):
     cloth = sim.World(str(SCENES / "cloth.yaml"))
-    with pytest.raises(ValueError, match=r"another scene \(bodies cloth \(225 nodes\).*this one \(bodies rope \(21 nodes\)"):
-        rope.restore(cloth.snapshot())
-    assert rope.positions().shape == (21, 3)
+    before = rope.positions()
+    for snapshot in (cloth.snapshot(), sim.Snapshot.from_bytes(cloth.snapshot().to_bytes())):
+        with pytest.raises(ValueError, match=r"cloth \(225 nodes\).*rope \(21 nodes\)"):
+            rope.restore(snapshot)
+    assert np.array_equal(rope.positions(), before)
+
+
+def test_bytes_that_are_no_snapshot_are_refused(rope):
+    data = rope.snapshot().to_bytes()
+    damaged = data[:-8] + bytes([data[-8] ^ 1]) + data[-7:]  # a bit of the values, which the checksum covers
+    for bad in (b"", b"not a snapshot at all", data[:-1], damaged):
+        with pytest.raises(ValueError):
+            sim.Snapshot.from_bytes(bad)
+    with pytest.raises(TypeError):
+        sim.Snapshot.from_bytes("a str is no bytes")
+
+
+def test_a_pickled_world_whose_scene_file_changed_is_refused(tmp_path):
+    scene = tmp_path / "rope.yaml"
+    rope = "bodies: [{name: rope, type: rope, nodes: %d, from: [0, 0, 1], to: [1, 0, 1], mass: 0.1, stiffness: 100}]\n"
+    scene.write_text(rope % 11)
+    data = pickle.dumps(sim.World(scene))
+    scene.write_text(rope % 12)
+    with pytest.raises(ValueError, match=r"rope \(11 nodes\).*rope \(12 nodes\)"):
+        pickle.loads(data)
