@@ -59,3 +59,27 @@ def test_positions_tensions_and_wrenches_equal_simulate_to_the_bit(name, simulat
         for anchor in w.anchors(body):
             force, torque = w.wrench(body, anchor)
             assert same_bits(force, forces[(body, anchor)][:3]) and same_bits(torque, forces[(body, anchor)][3:])
+
+
+def test_divergence_events_are_those_simulate_warns_of(simulate, tmp_path):
+    """A rope far too stiff for explicit Euler at its step: the guard catches it once and switches it to
+    implicit_euler. Python's events of the step() call are simulate's warnings, word for word."""
+    scene = tmp_path / "diverging.yaml"
+    scene.write_text("physics: {integrator: explicit_euler, dt: 0.01}\n"
+                     "bodies: [{name: rope, type: rope, nodes: 10, from: [0, 0, 1], to: [1, 0, 1], mass: 0.1,\n"
+                     "          stiffness: 100000.0, pinned: [0]}]\n")
+    run = subprocess.run([simulate, "--scene", str(scene), "--duration", "0.1", "--csv", str(tmp_path / "x.csv")],
+                         check=True, capture_output=True, text=True)
+    warned = [line.split("simulate: warning: ", 1)[1] for line in run.stderr.splitlines() if "diverged" in line]
+
+    w = sim.World(scene)
+    start = w.snapshot()
+    w.step(10)
+    assert len(warned) == 1 and [str(event) for event in w.divergence_events] == warned
+    [event] = w.divergence_events
+    assert event.body == "rope" and "implicit_euler" in event.action and 0.0 < event.time <= w.time
+    assert w.divergence_count == 1
+    w.step(10)
+    assert w.divergence_events == [] and w.divergence_count == 1  # the last call's catches; all since made
+    w.restore(start)
+    assert w.divergence_events == [] and w.divergence_count == 0
