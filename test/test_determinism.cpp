@@ -368,6 +368,9 @@ TEST(Determinism, SnapshotBytesOfAnotherSceneOrDamagedAreRefusedAndChangeNothing
   std::string flipped = rope_bytes;
   flipped[flipped.size() / 2] = static_cast<char>(flipped[flipped.size() / 2] ^ 1);
   EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes(flipped); }).find("damaged"), std::string::npos);
+  std::string renamed = rope_bytes;
+  renamed[32] = static_cast<char>(renamed[32] ^ 1);  // the header's scene summary: the checksum covers it too
+  EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes(renamed); }).find("damaged"), std::string::npos);
   std::string newer = rope_bytes;
   newer[12] = static_cast<char>(newer[12] + 1);  // the version, after the magic and the byte-order marker
   EXPECT_NE(refusal([&] { WorldSnapshot::fromBytes(newer); }).find("format version"), std::string::npos);

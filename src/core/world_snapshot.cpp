@@ -56,7 +56,7 @@ struct Header
   std::string summary;
   double time = 0.0;
   std::int64_t steps = 0;
-  std::uint64_t checksum = 0;  ///< of the values after the header
+  std::uint64_t checksum = 0;  ///< of all the bytes, these 8 (the header's last) taken as 0
 
   void carry(StateArchive& archive)
   {
@@ -92,11 +92,14 @@ std::string WorldSnapshot::toBytes() const
   header.summary = sceneSummary(world.model_);
   header.time = world.time();
   header.steps = world.stepCount();
-  header.checksum = hashOf(values.data(), values.size());
   std::string bytes;
   StateArchive header_writer(bytes);
   header.carry(header_writer);
-  return bytes + values;
+  bytes += values;
+  const std::size_t at = bytes.size() - values.size() - sizeof header.checksum;
+  header.checksum = hashOf(bytes.data(), bytes.size());
+  std::memcpy(bytes.data() + at, &header.checksum, sizeof header.checksum);
+  return bytes;
 }
 
 WorldSnapshot WorldSnapshot::fromBytes(std::string bytes)
@@ -105,8 +108,12 @@ WorldSnapshot WorldSnapshot::fromBytes(std::string bytes)
   StateArchive reader(bytes.data(), bytes.size());
   header.carry(reader);
   WorldSnapshot snapshot;
-  snapshot.body_ = bytes.size() - static_cast<std::size_t>(reader.left());
-  if (hashOf(bytes.data() + snapshot.body_, bytes.size() - snapshot.body_) != header.checksum)
+  snapshot.body_ = bytes.size() - reader.left();
+  const std::size_t at = snapshot.body_ - sizeof header.checksum;
+  std::memset(bytes.data() + at, 0, sizeof header.checksum);
+  const std::uint64_t checksum = hashOf(bytes.data(), bytes.size());
+  std::memcpy(bytes.data() + at, &header.checksum, sizeof header.checksum);
+  if (checksum != header.checksum)
     throw std::invalid_argument("snapshot bytes: damaged (their checksum does not match)");
   snapshot.fingerprint_ = header.fingerprint;
   snapshot.summary_ = std::move(header.summary);
