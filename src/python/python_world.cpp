@@ -6,8 +6,13 @@ namespace soft_body_sim::python
 {
 PythonWorld::PythonWorld(const std::string& scene) : scene_(scene), world_(buildWorld(loadSceneFile(scene))) {}
 
+PythonWorld::PythonWorld(const std::string& yaml_text, const std::string& source)
+  : scene_(source), yaml_text_(yaml_text), world_(buildWorld(parseScene(yaml_text, source)))
+{
+}
+
 PythonWorld::PythonWorld(const PythonWorld& other)
-  : scene_(other.scene_), world_(other.read([](const World& world) { return world; })), events_(other.lastEvents())
+  : scene_(other.scene_), yaml_text_(other.yaml_text_), world_(other.read([](const World& world) { return world; })), events_(other.lastEvents())
 {
 }
 

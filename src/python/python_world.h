@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,6 +19,10 @@ public:
   /// Loads `scene` as `simulate` does (loadSceneFile, buildWorld: `dt: auto`, package:// meshes). Throws
   /// SceneError for a file the loader refuses, std::invalid_argument for a scene buildWorld refuses.
   explicit PythonWorld(const std::string& scene);
+  /// Parses `yaml_text` as if it were the file `source` (parseScene: meshes by a relative path are found
+  /// from source's folder, and the loader's messages name source), then builds it as above. The file need
+  /// not exist: a sweep's run is its base scene with some values changed, never written to disk.
+  PythonWorld(const std::string& yaml_text, const std::string& source);
   /// A clone (World's copy) with `other`'s scene path and last catches.
   PythonWorld(const PythonWorld& other);
   PythonWorld& operator=(const PythonWorld&) = delete;
@@ -42,14 +47,17 @@ public:
     return std::forward<F>(f)(world_);
   }
 
-  /// The scene file's path as it was given.
+  /// The scene file's path as it was given (for a world of text, the source it was parsed as).
   const std::string& scene() const { return scene_; }
+  /// The YAML text the world was parsed from; none for a world loaded from its file.
+  const std::optional<std::string>& yamlText() const { return yaml_text_; }
   /// The divergence guard's catches in the last step() call, oldest first.
   std::vector<DivergenceEvent> lastEvents() const;
 
 private:
   mutable std::mutex mutex_;
   std::string scene_;
+  std::optional<std::string> yaml_text_;
   World world_;
   std::vector<DivergenceEvent> events_;
 };

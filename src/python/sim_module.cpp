@@ -241,6 +241,17 @@ class UnknownName(KeyError):
              return std::make_unique<PythonWorld>(path);
            }),
            py::arg("scene"), "Loads a scene file; sim.SceneError with the loader's line if it refuses it.")
+      .def_static(
+          "from_yaml",
+          [](const std::string& text, const py::object& source) {
+            const std::string path = pathString(source).cast<std::string>();
+            py::gil_scoped_release release;
+            return std::make_unique<PythonWorld>(text, path);
+          },
+          py::arg("text"), py::arg("source"),
+          "A world of scene YAML text, parsed as if it were the file `source` (which need not exist): meshes "
+          "by a relative path are found from source's folder, and sim.SceneError's line names source. The "
+          "same bits as World(path) of a file holding the text.")
       .def(
           "step",
           [](PythonWorld& w, std::int64_t steps) {
@@ -455,14 +466,20 @@ class UnknownName(KeyError):
           "__deepcopy__", [](const PythonWorld& w, const py::dict&) { return std::make_unique<PythonWorld>(w); },
           py::arg("memo"))
       // Pickled as its scene file's absolute path and a snapshot's bytes: unpickling loads the file again
-      // (refused, naming both scenes, if it changed) and restores the moment into it.
+      // (refused, naming both scenes, if it changed) and restores the moment into it. A world of text
+      // (from_yaml) carries its text as a third item, there being no file to load again.
       .def(py::pickle(
           [](const PythonWorld& w) {
             const WorldSnapshot now = w.read([](const World& world) { return world.snapshot(); });
-            return py::make_tuple(std::filesystem::absolute(w.scene()).string(), py::bytes(now.toBytes()));
+            const std::string source = std::filesystem::absolute(w.scene()).string();
+            if (!w.yamlText())
+              return py::make_tuple(source, py::bytes(now.toBytes()));
+            return py::make_tuple(source, py::bytes(now.toBytes()), *w.yamlText());
           },
           [](const py::tuple& state) {
-            auto w = std::make_unique<PythonWorld>(state[0].cast<std::string>());
+            auto w = state.size() == 3 ?
+                         std::make_unique<PythonWorld>(state[2].cast<std::string>(), state[0].cast<std::string>()) :
+                         std::make_unique<PythonWorld>(state[0].cast<std::string>());
             w->restore(snapshotOfBytes(state[1]));
             return w;
           }))
