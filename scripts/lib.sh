@@ -19,6 +19,7 @@ PACKAGES=(
   tetgen
   googletest libgtest-dev libbenchmark-dev
   pybind11-dev python3-dev python3-numpy python3-pytest
+  python3-distributed python3-h5py python3-yaml python3-matplotlib
   clang libclang-rt-14-dev
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   libinteractive-markers-dev libdiagnostic-updater-dev libnodeletlib-dev libnodeletlib-tools pluginlib-dev

@@ -1,0 +1,91 @@
+"""A sweep's output folder: runs.h5, every finished run's values, status and samples, and runs.csv, a row a
+run (docs/sweeps.md). Only the client writes them, a run at a time as it arrives, and runs.h5 is flushed after
+each: a sweep stopped at any point holds every run it had received, and a run is written once whatever Dask
+retried. runs.csv is made again from runs.h5 when a sweep starts and ends, so the two always agree.
+"""
+import csv
+import datetime
+import json
+import os
+
+import h5py
+import numpy as np
+
+FIXED_COLUMNS_BEFORE = ["id"]
+FIXED_COLUMNS_AFTER = ["status", "divergence_events", "cpu_seconds", "worker", "message"]
+
+
+class Store:
+    def __init__(self, folder, sweep):
+        os.makedirs(folder, exist_ok=True)
+        self.h5_path = os.path.join(folder, "runs.h5")
+        self.csv_path = os.path.join(folder, "runs.csv")
+        self.sweep = sweep
+        try:
+            self.h5 = h5py.File(self.h5_path, "a")
+        except OSError as e:
+            raise OSError(f"{self.h5_path}: cannot open for writing ({e}); a sweep still running into it, or "
+                          "a file cut short by a crash (delete it to start again)") from None
+        self.runs = self.h5.require_group("runs")
+        self.h5.attrs["sweep"] = os.path.abspath(sweep.path)
+        self.h5.attrs["scene"] = sweep.scene_path
+        self.h5.attrs["duration"] = sweep.duration
+        self.h5.attrs["record_every"] = sweep.record_every
+        self.columns = FIXED_COLUMNS_BEFORE + sweep.keys + FIXED_COLUMNS_AFTER
+        self.write_csv()
+        self.csv_file = open(self.csv_path, "a", newline="")
+        self.csv = csv.writer(self.csv_file)
+
+    def done(self):
+        """The ids of the runs already written (of this sweep file or an earlier one)."""
+        return set(self.runs.keys())
+
+    def add(self, result):
+        """Writes one run's result; a run already written (Dask ran it twice) is left as it is."""
+        if result["id"] in self.runs:
+            return False
+        group = self.runs.create_group(result["id"])
+        group.attrs["values"] = json.dumps(result["values"])
+        for key, value in result["values"].items():
+            group.attrs[key] = value if isinstance(value, (int, float, str)) else json.dumps(value)
+        for name in ("status", "message", "divergence_events", "cpu_seconds", "worker"):
+            group.attrs[name] = result[name]
+        group.attrs["finished"] = datetime.datetime.now(datetime.timezone.utc).isoformat()
+        if "time" in result:
+            group["time"] = result["time"]
+            group["time"].attrs["unit"] = "s"
+            group["positions"] = result["positions"]
+            group["positions"].attrs["unit"] = "m"
+            group["tensions"] = result["tensions"]
+            group["tensions"].attrs["unit"] = "N"
+            group["wrenches"] = result["wrenches"]
+            group["wrenches"].attrs["unit"] = "N (force x, y, z), N m (torque x, y, z, about the anchor's node)"
+            for name in ("node_names", "tension_bodies", "anchor_names"):
+                group[name] = np.array(result[name], dtype=h5py.string_dtype())
+        self.h5.flush()
+        self.csv.writerow(self.row(group))
+        self.csv_file.flush()
+        return True
+
+    def row(self, group):
+        values = json.loads(group.attrs["values"])
+        fields = {"id": group.name.rsplit("/", 1)[1],
+                  **{k: v if isinstance(v, (int, float, str)) else json.dumps(v) for k, v in values.items()}}
+        for name in FIXED_COLUMNS_AFTER:
+            value = group.attrs[name]
+            fields[name] = repr(float(value)) if name == "cpu_seconds" else value
+        return [fields.get(column, "") for column in self.columns]
+
+    def write_csv(self):
+        """runs.csv afresh: a row for each of this sweep's runs in runs.h5, in the sweep's order."""
+        with open(self.csv_path, "w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(self.columns)
+            for run in self.sweep.runs:
+                if run.id in self.runs:
+                    writer.writerow(self.row(self.runs[run.id]))
+
+    def close(self):
+        self.csv_file.close()
+        self.write_csv()
+        self.h5.close()
