@@ -6,6 +6,8 @@ import csv
 import datetime
 import json
 import os
+import re
+import shlex
 import signal
 import socket
 import subprocess
@@ -16,7 +18,7 @@ import distributed
 import h5py
 import pytest
 
-from conftest import SCENES, same_bits
+from conftest import ROOT, SCENES, same_bits
 from soft_body_sim import sweep, sweep_run
 from soft_body_sim.sweep_file import read_sweep
 
@@ -246,3 +248,19 @@ def test_a_bad_sweep_file_stops_before_any_run_with_one_line(tmp_path, capsys, t
     assert err.count("\n") == 1 and err.startswith(f"{path}:{message}"), err
     assert not (tmp_path / "results").exists()
 
+
+def test_the_readmes_example_finds_the_recorded_stiffness_back(tmp_path):
+    """The README's "Sweeps" commands as written, from the repository root, the output folder in tmp_path."""
+    readme = (ROOT / "README.md").read_text()
+    section = readme.split("\n## Sweeps\n", 1)[1].split("\n## ", 1)[0]
+    [block] = re.findall(r"```sh\n(.*?)```", section, re.S)
+    for line in block.strip().splitlines():
+        args = shlex.split(line.replace("/tmp/stiffness", str(tmp_path / "stiffness")))
+        # This test's python3 (Debian's) for `python3 -m` and for the script, whatever is first on PATH.
+        args = [sys.executable] + (args[1:] if args[0] == "python3" else args)
+        run = subprocess.run(args, cwd=ROOT, check=True, capture_output=True, text=True)
+    estimate = float(re.match(r"stiffness (\d+) N/m", run.stdout).group(1))
+    # The recording's 2 mm of noise per coordinate make the estimate's standard deviation 2.0 N/m (2 mm over
+    # the root sum of squares of the nodes' sensitivity, up to 0.32 mm per N/m at the middle): 8 N/m is 4 of them.
+    assert abs(estimate - 237.0) <= 8.0
+    assert (tmp_path / "stiffness" / "fit.png").stat().st_size > 0
