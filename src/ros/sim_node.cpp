@@ -132,7 +132,6 @@ void SimNode::buildWorldFromScene()
 
 void SimNode::followFrames()
 {
-  max_steps_per_tick_ = std::max(1L, std::lround(std::ceil(2.0 / (rate_ * world_->settings().dt))));
   const std::vector<Anchor>& anchors = world_->model().anchors;
   for (std::size_t k = 0; k < anchors.size(); ++k)
   {
@@ -155,6 +154,7 @@ void SimNode::followFrames()
 
 void SimNode::restartAtWorldTime()
 {
+  max_steps_per_tick_ = std::max(1L, std::lround(std::ceil(2.0 / (rate_ * world_->settings().dt))));
   next_state_time_ = world_->time();
   targets_.clear();
   inputs_.clear();

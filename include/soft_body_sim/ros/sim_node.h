@@ -76,8 +76,8 @@ private:
   /// Every anchor, collider and grasp that follows a tf frame (the scene's, ~attach's, ~grasp's) follows it
   /// afresh.
   void followFrames();
-  /// What the node keeps of the world's moment starts again from the world's time: the state timer, the
-  /// inputs waiting for their stamps, the glides, the cameras' frames.
+  /// What the node keeps of the world's moment starts again from the world's time and step: the catch-up
+  /// cap, the state timer, the inputs waiting for their stamps, the glides, the cameras' frames.
   void restartAtWorldTime();
 
   // --- inputs (sim_node_inputs.cpp)

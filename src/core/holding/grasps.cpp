@@ -103,12 +103,14 @@ void GraspSet::carry(StateArchive& archive)
     archive(grasps_, goals_);
     return;
   }
-  const std::vector<GraspedNodes> before = grasps_;
+  std::vector<std::string> names_before;
+  for (const GraspedNodes& grasp : grasps_)
+    names_before.push_back(grasp.name);
   std::vector<GraspPath> paths_before = std::move(paths_);
   archive(grasps_, goals_);
   paths_.assign(grasps_.size(), GraspPath{});
-  for (std::size_t k = 0; k < before.size(); ++k)
-    if (const std::size_t now = find(before[k].name); now < grasps_.size())
+  for (std::size_t k = 0; k < names_before.size(); ++k)
+    if (const std::size_t now = find(names_before[k]); now < grasps_.size())
       paths_[now] = std::move(paths_before[k]);
 }
 
