@@ -5,13 +5,12 @@
 - the run itself: the steps of a run, timed in this process (World.step, nothing else), averaged over runs;
 - overhead per run: one worker's wall time for the sweep, cluster start excluded, over the runs, less the run
   itself: what loading the scene, sampling, shipping the result, scheduling and writing runs.h5 add;
-- speed-up: one worker's wall time over two workers'.
+- speed-up: one worker's wall time over two workers', for each of `--pairs` pairs, and their median.
 
-  source build/devel/setup.bash && /usr/bin/python3 bench/bench_sweep.py [--duration S] [--runs-timed N]
+  source build/devel/setup.bash && /usr/bin/python3 bench/bench_sweep.py [--duration S] [--runs-timed N] [--pairs K]
 """
 import argparse
 import io
-import logging
 import os
 import pathlib
 import resource
@@ -19,7 +18,6 @@ import shutil
 import tempfile
 import time
 
-import distributed
 import numpy as np
 
 from soft_body_sim import sim, sweep
@@ -72,15 +70,14 @@ def busy_seconds():
 
 
 def sweep_seconds(s, out, workers):
-    """The wall time [s] of the whole sweep on a local cluster of `workers`, the cluster already started, and
-    the cores [1] that other processes kept busy meanwhile (the machine is shared: RESULTS.md, "The
-    machine"), from start to close of the cluster, and the CPU seconds of this process (the client, and the
-    local cluster's scheduler, which runs in it) during the sweep."""
+    """The wall time [s] of the whole sweep on a local cluster of `workers` as the command makes it (the
+    cluster already started), the cores [1] that other processes kept busy meanwhile (the machine is shared:
+    RESULTS.md, "The machine"), from start to close of the cluster, and the CPU seconds of this process (the
+    client, and the local cluster's scheduler, which runs in it) during the sweep."""
     machine, own = busy_seconds()
     started = time.perf_counter()
-    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                  dashboard_address=None, silence_logs=logging.ERROR) as cluster, \
-            distributed.Client(cluster) as client:
+    client, cluster = sweep.make_client(None, workers)
+    with cluster, client:
         client.wait_for_workers(workers)
         start, client_cpu = time.perf_counter(), time.process_time()
         lost = sweep.run_sweep(s, out, client=client, stream=io.StringIO())
@@ -96,23 +93,29 @@ def main():
     parser.add_argument("--duration", type=float, default=300.0, help="[s] simulated per run (default 300)")
     parser.add_argument("--record-every", type=float, default=10.0, help="[s] between samples (default 10)")
     parser.add_argument("--runs-timed", type=int, default=20, help="runs timed alone for the run itself")
+    parser.add_argument("--pairs", type=int, default=3, help="sweeps on 1 worker then 2, this many times")
     args = parser.parse_args()
+    ratios = []
     with tempfile.TemporaryDirectory() as tmp:
         folder = pathlib.Path(tmp)
         s = read_sweep(write_sweep(folder, args.duration, args.record_every))
+        n = len(s.runs)
         alone = step_seconds(s, args.runs_timed)
-        one, others_one, client_one = sweep_seconds(s, folder / "one", 1)
-        two, others_two, client_two = sweep_seconds(s, folder / "two", 2)
-    n = len(s.runs)
-    print(f"{n} runs of {args.duration:g} s of a 51-node rope ({steps_of(args.duration, 1 / 60)} steps), "
-          f"sampled every {args.record_every:g} s")
-    print(f"the run itself (its steps, in-process, mean of {args.runs_timed}): {1000 * alone:.1f} ms")
-    print(f"1 worker: {one:.2f} s, {1000 * one / n:.1f} ms a run: overhead {1000 * (one / n - alone):.1f} ms a run "
-          f"(client and scheduler {1000 * client_one / n:.1f} ms CPU a run; other processes kept {others_one:.2f} "
-          "cores busy)")
-    print(f"2 workers: {two:.2f} s, {1000 * two / n:.1f} ms a run: {one / two:.2f} times 1 worker "
-          f"(client and scheduler {1000 * client_two / n:.1f} ms CPU a run; other processes kept {others_two:.2f} "
-          "cores busy)")
+        print(f"{n} runs of {args.duration:g} s of a 51-node rope ({steps_of(args.duration, 1 / 60)} steps), "
+              f"sampled every {args.record_every:g} s")
+        print(f"the run itself (its steps, in-process, mean of {args.runs_timed}): {1000 * alone:.1f} ms")
+        for k in range(args.pairs):
+            one, others_one, client_one = sweep_seconds(s, folder / f"one{k}", 1)
+            two, others_two, client_two = sweep_seconds(s, folder / f"two{k}", 2)
+            ratios.append(one / two)
+            print(f"1 worker: {one:.2f} s, {1000 * one / n:.1f} ms a run: overhead {1000 * (one / n - alone):.1f} ms "
+                  f"a run (client and scheduler {1000 * client_one / n:.1f} ms CPU a run; other processes kept "
+                  f"{others_one:.2f} cores busy)")
+            print(f"2 workers: {two:.2f} s, {1000 * two / n:.1f} ms a run: {one / two:.2f} times 1 worker (client and "
+                  f"scheduler {1000 * client_two / n:.1f} ms CPU a run; other processes kept {others_two:.2f} cores "
+                  "busy)")
+    print(f"2 workers over 1, median of {args.pairs} pairs: {float(np.median(ratios)):.2f} "
+          f"(from {min(ratios):.2f} to {max(ratios):.2f})")
 
 
 if __name__ == "__main__":

@@ -5,11 +5,13 @@ process per core, or an existing cluster's scheduler. Results go to FOLDER/runs.
 runs finish; the same command after a stop runs only the runs FOLDER does not hold yet.
 """
 import argparse
+import collections
 import logging
 import os
 import sys
 import time
 
+import dask
 import distributed
 
 from soft_body_sim import sweep_run
@@ -20,6 +22,16 @@ from soft_body_sim.sweep_store import Store
 # gives its tasks to the others, up to distributed.scheduler.allowed-failures deaths per task). A run's
 # own errors (a refused scene) are results, not exceptions, so only the unexpected is retried.
 RETRIES = 2
+
+# Runs go to Dask in tasks of several runs, aimed at TASK_SECONDS of CPU each: a task costs the client and the
+# scheduler about 5 ms of CPU (bench/bench_sweep.py), which on a 2-core machine is CPU the workers do not get;
+# at 0.5 s a task that is 1 %. The first tasks hold a run each, and the first run to step sets the size of the
+# rest; the last tasks shrink to a run each, so that no worker waits on another's long task at the end.
+TASK_SECONDS = 0.5
+MAX_RUNS_PER_TASK = 16
+# Tasks a worker thread is given at the end (from the rest of the runs, at most one run each); also the number
+# of one-run tasks a thread is given first, while the size of the rest is not known.
+TAIL_TASKS_PER_THREAD = 4
 
 
 class Progress:
@@ -50,20 +62,76 @@ class Progress:
         self.stream.flush()
 
 
+# The local cluster's housekeeping, made rarer than Dask's defaults: at those, an idle cluster of two workers
+# keeps 12 % of a core busy (each worker sampling its own stack for the dashboard's profile, every 10 ms, and
+# measuring its memory every 0.1 s; the scheduler ticking every 20 ms and measuring the machine every 0.5 s),
+# which on a 2-core machine the runs do not get; at these, 4 % (bench/bench_sweep.py). The cluster has no
+# dashboard to show them; a worker still checks its memory limit every second.
+LOCAL_CLUSTER_CONFIG = {
+    "distributed.worker.profile.enabled": False,
+    "distributed.worker.memory.monitor-interval": "1s",
+    "distributed.admin.tick.interval": "1s",
+    "distributed.admin.system-monitor.interval": "5s",
+    "distributed.scheduler.active-memory-manager.start": False,
+}
+
+
 def make_client(scheduler, workers):
     """A Dask client: of the scheduler at `scheduler`, or of a local cluster of `workers` processes with one
     thread each (a run keeps one core busy for its whole length, and a process per worker keeps a crash in
     one run to that worker)."""
     if scheduler:
         return distributed.Client(scheduler), None
-    cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
-                                       dashboard_address=None, silence_logs=logging.ERROR)
-    return distributed.Client(cluster), cluster
+    with dask.config.set(LOCAL_CLUSTER_CONFIG):
+        cluster = distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                           dashboard_address=None, silence_logs=logging.ERROR)
+        return distributed.Client(cluster), cluster
 
 
 def specs_of(sweep, runs):
     return [sweep_run.RunSpec(run.id, run.values, sweep.run_scene(run), sweep.scene_path, sweep.duration,
                               sweep.record_every) for run in runs]
+
+
+class Tasks:
+    """The runs of `specs` as Dask tasks on `client`, sized as TASK_SECONDS says; iterated, each task as it
+    finishes (in any order): its future and its runs."""
+
+    def __init__(self, client, specs):
+        self.client = client
+        self.pending = collections.deque(specs)
+        self.runs_of = {}
+        self.finished = distributed.as_completed()
+        self.threads = max(1, sum(client.nthreads().values()))
+        self.runs_per_task = None
+        for _ in range(min(len(self.pending), TAIL_TASKS_PER_THREAD * self.threads)):
+            self.submit(1)
+
+    def submit(self, count):
+        runs = [self.pending.popleft() for _ in range(count)]
+        future = self.client.submit(sweep_run.run_batch, runs, key=f"soft_body_sim-runs-{runs[0].id}-{count}",
+                                    retries=RETRIES, pure=False)
+        self.runs_of[future.key] = runs
+        self.finished.add(future)
+
+    def size_the_rest(self, run_seconds):
+        """The rest of the runs in tasks of TASK_SECONDS at `run_seconds` [s] a run (None: unknown, a run a
+        task), fewer near the end."""
+        self.runs_per_task = 1 if run_seconds is None else \
+            max(1, min(MAX_RUNS_PER_TASK, int(TASK_SECONDS / max(run_seconds, 1e-6))))
+        while self.pending:
+            tail = len(self.pending) // (TAIL_TASKS_PER_THREAD * self.threads)
+            self.submit(max(1, min(self.runs_per_task, tail)))
+
+    def __iter__(self):
+        for future in self.finished:
+            runs = self.runs_of.pop(future.key)
+            if self.runs_per_task is None:
+                stepped = [] if future.status == "error" else \
+                    [result["cpu_seconds"] for result in future.result() if "time" in result]
+                if stepped or self.finished.is_empty():
+                    self.size_the_rest(max(stepped) if stepped else None)
+            yield future, runs
 
 
 def run_sweep(sweep, out, scheduler=None, workers=None, stream=None, client=None):
@@ -84,20 +152,20 @@ def run_sweep(sweep, out, scheduler=None, workers=None, stream=None, client=None
         if own:
             client, cluster = make_client(scheduler, workers or len(os.sched_getaffinity(0)))
         try:
-            futures = client.map(sweep_run.run, specs, key=[f"soft_body_sim-run-{s.id}" for s in specs],
-                                 retries=RETRIES)
-            progress = Progress(len(futures), stream)
+            progress = Progress(len(specs), stream)
             lost = []
-            # Written here, one at a time as they finish, never by the workers: a run Dask retried or ran on
-            # two workers arrives once per future, and store.add keeps the first.
-            for future in distributed.as_completed(futures):
+            # Written here as each task finishes, and flushed, never by the workers: a task Dask retried or ran
+            # on two workers arrives once per future, and store.add keeps the first.
+            for future, runs in Tasks(client, specs):
                 if future.status == "error":
-                    lost.append(f"{future.key}: {future.exception()}")
-                    progress.update(failed=True)
+                    lost += [f"{run.id}: {future.exception()}" for run in runs]
+                    for _ in runs:
+                        progress.update(failed=True)
                 else:
-                    result = future.result()
-                    store.add(result)
-                    progress.update(failed=result["status"] != "ok")
+                    for result in future.result():
+                        store.add(result)
+                        progress.update(failed=result["status"] != "ok")
+                    store.flush()
                 future.release()
             for line in lost:
                 stream.write(f"sweep: lost {line}\n")

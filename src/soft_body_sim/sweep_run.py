@@ -95,3 +95,8 @@ def run(spec):
         anchor_names=[f"{body}/{anchor}" for body, anchor in anchors],
         cpu_seconds=time.thread_time() - started)
     return result
+
+
+def run_batch(specs):
+    """The results of `specs`, run one after another (a Dask task of several runs: sweep.TASK_SECONDS)."""
+    return [run(spec) for spec in specs]

@@ -1,10 +1,11 @@
 """A sweep's output folder: runs.h5, every finished run's values, status and samples, and runs.csv, a row a
-run (docs/sweeps.md). Only the client writes them, a run at a time as it arrives, and runs.h5 is flushed after
-each: a sweep stopped at any point holds every run it had received, and a run is written once whatever Dask
-retried. runs.csv is made again from runs.h5 when a sweep starts and ends, so the two always agree.
+run (docs/sweeps.md). Only the client writes them, the runs of a task as it arrives, and flushes them after
+each task: a sweep stopped at any point holds every run it had received, and a run is written once whatever
+Dask retried. runs.csv is made again from runs.h5 when a sweep starts and ends, so the two always agree.
 """
 import csv
 import datetime
+import hashlib
 import json
 import os
 
@@ -13,6 +14,18 @@ import numpy as np
 
 FIXED_COLUMNS_BEFORE = ["id"]
 FIXED_COLUMNS_AFTER = ["status", "divergence_events", "cpu_seconds", "worker", "message"]
+
+
+SCALAR = h5py.h5s.create(h5py.h5s.SCALAR)
+
+
+def write_attrs(obj, attrs):
+    """Sets `attrs` (str, int, float or bool values) on the new h5py group or dataset `obj`, as its .attrs[name]
+    = value would, through h5py's low-level calls: a third of the cost (the high-level call checks and
+    converts each value in Python), and a run has a dozen attributes."""
+    for name, value in attrs.items():
+        data = np.array(value, dtype=h5py.string_dtype() if isinstance(value, str) else None)
+        h5py.h5a.create(obj.id, name.encode(), h5py.h5t.py_create(data.dtype, logical=True), SCALAR).write(data)
 
 
 class Store:
@@ -27,6 +40,8 @@ class Store:
             raise OSError(f"{self.h5_path}: cannot open for writing ({e}); a sweep still running into it, or "
                           "a file cut short by a crash (delete it to start again)") from None
         self.runs = self.h5.require_group("runs")
+        self.names = self.h5.require_group("names")
+        self.names_by_key = {}
         self.h5.attrs["sweep"] = os.path.abspath(sweep.path)
         self.h5.attrs["scene"] = sweep.scene_path
         self.h5.attrs["duration"] = sweep.duration
@@ -45,27 +60,38 @@ class Store:
         if result["id"] in self.runs:
             return False
         group = self.runs.create_group(result["id"])
-        group.attrs["values"] = json.dumps(result["values"])
+        attrs = {"values": json.dumps(result["values"])}
         for key, value in result["values"].items():
-            group.attrs[key] = value if isinstance(value, (int, float, str)) else json.dumps(value)
+            attrs[key] = value if isinstance(value, (int, float, str)) else json.dumps(value)
         for name in ("status", "message", "divergence_events", "cpu_seconds", "worker"):
-            group.attrs[name] = result[name]
-        group.attrs["finished"] = datetime.datetime.now(datetime.timezone.utc).isoformat()
+            attrs[name] = result[name]
+        attrs["finished"] = datetime.datetime.now(datetime.timezone.utc).isoformat()
+        write_attrs(group, attrs)
         if "time" in result:
-            group["time"] = result["time"]
-            group["time"].attrs["unit"] = "s"
-            group["positions"] = result["positions"]
-            group["positions"].attrs["unit"] = "m"
-            group["tensions"] = result["tensions"]
-            group["tensions"].attrs["unit"] = "N"
-            group["wrenches"] = result["wrenches"]
-            group["wrenches"].attrs["unit"] = "N (force x, y, z), N m (torque x, y, z, about the anchor's node)"
+            for name, unit in (("time", "s"), ("positions", "m"), ("tensions", "N"),
+                               ("wrenches", "N (force x, y, z), N m (torque x, y, z, about the anchor's node)")):
+                group.create_dataset(name, data=result[name]).attrs["unit"] = unit
             for name in ("node_names", "tension_bodies", "anchor_names"):
-                group[name] = np.array(result[name], dtype=h5py.string_dtype())
-        self.h5.flush()
+                group[name] = self.shared_names(result[name])
         self.csv.writerow(self.row(result["id"], result["values"], result))  # from memory: h5 reads cost ms
-        self.csv_file.flush()
         return True
+
+    def flush(self):
+        """Everything added so far to the files (runs.csv's rows are never ahead of runs.h5's runs)."""
+        self.h5.flush()
+        self.csv_file.flush()
+
+    def shared_names(self, names):
+        """The dataset names/<key> of the list `names`, written the first time: the runs that name the same
+        nodes (most of a sweep's) link to one dataset (an HDF5 hard link: read as the run's own), which costs
+        a fraction of writing it again."""
+        key = hashlib.sha256(json.dumps(names).encode()).hexdigest()[:16]
+        dataset = self.names_by_key.get(key)
+        if dataset is None:
+            dataset = self.names[key] if key in self.names else \
+                self.names.create_dataset(key, data=np.array(names, dtype=h5py.string_dtype()))
+            self.names_by_key[key] = dataset
+        return dataset
 
     def row(self, run_id, values, fixed):
         """runs.csv's row of a run: its values, then FIXED_COLUMNS_AFTER taken from `fixed`."""

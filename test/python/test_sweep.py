@@ -102,6 +102,29 @@ def test_a_local_cluster_gives_the_bits_of_the_runs_done_in_process_and_records_
     assert "sweep: 12 runs, 0 already in" in capsys.readouterr().err
 
 
+def test_tasks_of_several_runs_give_the_same_bits_and_share_the_names(tmp_path, monkeypatch):
+    # One worker, no tail, tasks of up to 16 runs: a one-run task first, then the other 11 runs in one task.
+    monkeypatch.setattr(sweep, "TAIL_TASKS_PER_THREAD", 1)
+    monkeypatch.setattr(sweep, "TASK_SECONDS", 100.0)
+    sizes = []
+    submit = sweep.Tasks.submit
+    monkeypatch.setattr(sweep.Tasks, "submit", lambda tasks, count: (sizes.append(count), submit(tasks, count)))
+    path = write_sweep(tmp_path)
+    assert sweep.main([str(path), "--out", str(tmp_path / "results"), "--workers", "1"]) == 0
+    assert sizes == [1, 11]
+    truth = serial_results(path)
+    assert_output_is(tmp_path / "results", truth)
+    with h5py.File(tmp_path / "results" / "runs.h5", "r") as h5:
+        stepped = [run for run in h5["runs"].values() if "time" in run]
+        names = [run[name] for run in stepped for name in ("node_names", "tension_bodies", "anchor_names")]
+        # The 21-node rope in every run: one dataset of each list, which every run's link reads.
+        assert len(h5["names"]) == 3
+        assert {tuple(n.asstr()[()]) for n in names} == {tuple(h5["names"][key].asstr()[()]) for key in h5["names"]}
+        assert [n.asstr()[()].tolist() for n in names[:3]] == [truth[stepped[0].name.split("/")[-1]][name] for name
+                                                               in ("node_names", "tension_bodies", "anchor_names")]
+        assert len({n.id for n in names[0::3]}) == 1  # one HDF5 object, not copies
+
+
 def test_a_run_has_the_bits_of_simulate_of_its_scene(tmp_path, simulate):
     path = write_sweep(tmp_path)
     s = read_sweep(path)
