@@ -25,10 +25,14 @@ constexpr double kNearParallelSine2 = 0.03;
 /// recomputed for the clamped end. A segment of zero length is its first point.
 /// Segments within `parallel_sine2` (sin^2 of the angle between them, 0: none) of parallel, whose lines
 /// come closest at an ill-conditioned point, meet at the nearest of each one's ends to the other segment
-/// instead; with 0, exactly parallel ones (a * e - b^2 <= 0) take s = 0, as Ericson does.
+/// instead; with 0, exactly parallel ones (a * e - b^2 <= 0) take s = 0, as Ericson does. `by_ends`, if
+/// given, tells whether that rule chose the points (they are then no nearer than the segments' nearest).
 inline std::pair<double, double> closestSegmentParameters(const Vec3& p0, const Vec3& d1, const Vec3& q0,
-                                                           const Vec3& d2, double parallel_sine2 = 0.0)
+                                                           const Vec3& d2, double parallel_sine2 = 0.0,
+                                                           bool* by_ends = nullptr)
 {
+  if (by_ends != nullptr)
+    *by_ends = false;
   const Vec3 r = p0 - q0;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
   if (!(a > 0.0) && !(e > 0.0))
@@ -41,6 +45,8 @@ inline std::pair<double, double> closestSegmentParameters(const Vec3& p0, const 
   const double b = d1.dot(d2), denominator = a * e - b * b;
   if (parallel_sine2 > 0.0 && denominator < parallel_sine2 * a * e)
   {
+    if (by_ends != nullptr)
+      *by_ends = true;
     const std::pair<double, double> ends[4] = { { 0.0, std::clamp(f / e, 0.0, 1.0) },
                                                 { 1.0, std::clamp((b + f) / e, 0.0, 1.0) },
                                                 { std::clamp(-c / a, 0.0, 1.0), 0.0 },

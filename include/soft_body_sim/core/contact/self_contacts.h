@@ -145,7 +145,7 @@ public:
   /// (state_archive.h); the links, faces and their radii are the scene's.
   void carry(StateArchive& archive)
   {
-    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, tick_,
+    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, travel_, tick_,
             face_centre_, face_extent_, face_grid_, face_candidates_, near_faces_);
   }
 
@@ -246,14 +246,15 @@ private:
   std::vector<double> moved_;
   std::size_t searches_ = 0;
   /// Two links' contact at some positions: their nearest points' parameters p (on s) and q (on t), the
-  /// distance [m] and unit normal n from t's point to s's, each node's share (its weight there times its
-  /// inverse mass) and their sum weighted again (resolve).
+  /// distance [m] and unit normal n from t's point to s's, the links' least distance (the contact's, or less
+  /// where kNearParallelSine2 took their ends) [m], each node's share (its weight there times its inverse
+  /// mass) and their sum weighted again (resolve).
   struct Contact
   {
-    double p, q, distance, ka, kb, kc, kd, weight;
+    double p, q, distance, least, ka, kb, kc, kd, weight;
     Vec3 n;
 
-    void carry(StateArchive& archive) { archive(p, q, distance, ka, kb, kc, kd, weight, n); }
+    void carry(StateArchive& archive) { archive(p, q, distance, least, ka, kb, kc, kd, weight, n); }
   };
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
@@ -264,12 +265,16 @@ private:
     Contact contact{};   ///< its contact when last looked at (at tick `seen`)
     bool valid = false;  ///< that contact has a direction and a free node
     std::uint64_t seen = 0;
+    double travel = 0.0;  ///< [m] its four nodes' travel_, summed, at tick `seen`
 
-    void carry(StateArchive& archive) { archive(s, t, push, stop, contact, valid, seen); }
+    void carry(StateArchive& archive) { archive(s, t, push, stop, contact, valid, seen, travel); }
   };
   std::vector<NearPair> near_;
   /// per node (global index): the tick_ of the last push that moved it
   std::vector<std::uint64_t> moved_at_;
+  /// per node (global index): how far the passes of this resolve have moved it, summed [m] (from 0 for the
+  /// colliding nodes at each call)
+  std::vector<double> travel_;
   std::uint64_t tick_ = 0;  ///< counts resolve's pushes of positions, over all sub-steps
 
   std::vector<std::array<int, 3>> faces_;  ///< the contact triangles of the colliding cloths
