@@ -145,7 +145,7 @@ public:
   /// (state_archive.h); the links, faces and their radii are the scene's.
   void carry(StateArchive& archive)
   {
-    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, travel_, tick_,
+    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, travel_, entry_, tick_,
             face_centre_, face_extent_, face_grid_, face_candidates_, near_faces_);
   }
 
@@ -259,6 +259,13 @@ private:
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
   {
+    /// Whether the pair is near (its contact at the sub-step's start within the near radii), once looked at.
+    enum class Admission : std::uint8_t
+    {
+      Unknown,
+      Near,
+      Far
+    };
     std::uint32_t s, t;  ///< segment indices
     double push;         ///< [m] the normal passes' push apart, less what friction has cancelled / mu
     double stop;         ///< [m/s] the approach speed they removed, likewise
@@ -266,8 +273,10 @@ private:
     bool valid = false;  ///< that contact has a direction and a free node
     std::uint64_t seen = 0;
     double travel = 0.0;  ///< [m] its four nodes' travel_, summed, at tick `seen`
+    double bound = 0.0;   ///< [m] at most their least distance at the sub-step's start
+    Admission admission = Admission::Unknown;
 
-    void carry(StateArchive& archive) { archive(s, t, push, stop, contact, valid, seen, travel); }
+    void carry(StateArchive& archive) { archive(s, t, push, stop, contact, valid, seen, travel, bound, admission); }
   };
   std::vector<NearPair> near_;
   /// per node (global index): the tick_ of the last push that moved it
@@ -275,6 +284,7 @@ private:
   /// per node (global index): how far the passes of this resolve have moved it, summed [m] (from 0 for the
   /// colliding nodes at each call)
   std::vector<double> travel_;
+  NodeArray entry_;  ///< the positions at the start of this resolve [m]
   std::uint64_t tick_ = 0;  ///< counts resolve's pushes of positions, over all sub-steps
 
   std::vector<std::array<int, 3>> faces_;  ///< the contact triangles of the colliding cloths
