@@ -458,10 +458,14 @@ bool SelfContacts::resolve(const Model& model, State& state)
   const auto moved = [&](const std::pair<int, int>& segment) {
     return std::max(moved_[static_cast<std::size_t>(segment.first)], moved_[static_cast<std::size_t>(segment.second)]);
   };
-  for (const Candidate& candidate : candidates_)
+  near_index_.resize(candidates_.size());
+  candidate_bound_.resize(candidates_.size());
+  for (std::size_t i = 0; i < candidates_.size(); ++i)
   {
+    const Candidate& candidate = candidates_[i];
     const std::uint32_t s = candidate.s, t = candidate.t;
     const double touching = near_radius_[s] + near_radius_[t];
+    near_index_[i] = kFar;
     // Their points have moved, relative to the mean motion (which changes no distance), no farther than
     // their farthest node: a pair whose least distance was more than that beyond the contact distance is
     // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
@@ -470,29 +474,36 @@ bool SelfContacts::resolve(const Model& model, State& state)
     if (candidate.distance - moved(segments_[s]) - moved(segments_[t]) > touching * (1.0 + 1e-9) + 1e-12)
       continue;
     // Near if their contact at this call's start is within their near radii; whether it is, is found only
-    // once the passes could have brought them into touch (admitted), from the positions then (entry_).
-    NearPair pair{ s, t, 0.0, 0.0 };
-    pair.bound = candidate.distance - moved(segments_[s]) - moved(segments_[t]);
-    near_.push_back(pair);
+    // once the passes could have brought them into touch (nearPair), from the positions then (entry_).
+    near_index_[i] = kUnknown;
+    candidate_bound_[i] = candidate.distance - moved(segments_[s]) - moved(segments_[t]);
   }
-  // Whether a pair is near, found the first time it is asked while its links may touch (their least
-  // distance at the start, bounded below by pair.bound, less what the passes have moved their nodes, within
-  // their radii): a pair that cannot touch yet has a pass that changes nothing, near or not. The contact at
-  // the start and the tick then, as if found before the passes: the same contacts, pushes and bits as
-  // finding every pair's before them, without the nearest points of the most, which never come near touch
-  // in a sub-step (in the demo's coil, 270 of the 313 near pairs each sub-step, and more candidates).
-  const auto admitted = [&](NearPair& pair) {
-    if (pair.admission == NearPair::Admission::Unknown)
+  // Candidate i's near pair, or none: whether it is near is found the first time it is asked while its links
+  // may touch (their least distance at the start, bounded below by candidate_bound_, less what the passes
+  // have moved their nodes, within their radii): a pair that cannot touch yet has a pass that changes
+  // nothing, near or not. Its contact at the start and the tick then, as if found before the passes: the
+  // same contacts, pushes and bits as finding every pair's before them, without the nearest points of the
+  // most, which never come near touch in a sub-step (in the demo's coil, 270 of the 313 near pairs each
+  // sub-step, and more candidates). The passes take the near pairs in the candidates' order.
+  const auto near_pair = [&](std::size_t i) -> NearPair* {
+    if (near_index_[i] == kUnknown)
     {
-      if (pair.bound - travelled(pair.s, pair.t) > (radius_[pair.s] + radius_[pair.t]) * (1.0 + 1e-9) + 1e-12)
-        return false;
-      pair.valid = contact_at(entry_, pair.s, pair.t, pair.contact);
+      const std::uint32_t s = candidates_[i].s, t = candidates_[i].t;
+      if (candidate_bound_[i] - travelled(s, t) > (radius_[s] + radius_[t]) * (1.0 + 1e-9) + 1e-12)
+        return nullptr;
+      NearPair pair{ s, t, 0.0, 0.0 };
+      pair.valid = contact_at(entry_, s, t, pair.contact);
       pair.seen = entry_tick;
       pair.travel = 0.0;
-      pair.admission = pair.contact.distance < near_radius_[pair.s] + near_radius_[pair.t] ? NearPair::Admission::Near
-                                                                                           : NearPair::Admission::Far;
+      if (!(pair.contact.distance < near_radius_[s] + near_radius_[t]))
+      {
+        near_index_[i] = kFar;
+        return nullptr;
+      }
+      near_index_[i] = static_cast<std::int32_t>(near_.size());
+      near_.push_back(pair);
     }
-    return pair.admission == NearPair::Admission::Near;
+    return near_index_[i] >= 0 ? &near_[static_cast<std::size_t>(near_index_[i])] : nullptr;
   };
   bool touched = false;
   // A pair's contact as the passes left its nodes: the one it last had unless one of its nodes has moved
@@ -557,10 +568,12 @@ bool SelfContacts::resolve(const Model& model, State& state)
                (radius_[pair.s] + radius_[pair.t]) * (1.0 + 1e-9) + 1e-12;
   };
   for (int pass = 0; pass < kPasses; ++pass)
-    for (NearPair& pair : near_)
+    for (std::size_t i = 0; i < candidates_.size(); ++i)
     {
-      if (!admitted(pair) || stays_apart(pair))
+      NearPair* near = near_pair(i);
+      if (near == nullptr || stays_apart(*near))
         continue;
+      NearPair& pair = *near;
       const Contact* found = current(pair);
       if (found == nullptr)
         continue;
@@ -585,8 +598,11 @@ bool SelfContacts::resolve(const Model& model, State& state)
   // normal passes, not in them: in a groove, a link's motion into the other side is tangential at the
   // first side's contact, and friction there would spend its budget against what the other side stops.
   for (int pass = 0; pass < kPasses; ++pass)
-    for (NearPair& pair : near_)
+    for (std::size_t i = 0; i < candidates_.size(); ++i)
     {
+      if (near_index_[i] < 0)
+        continue;
+      NearPair& pair = near_[static_cast<std::size_t>(near_index_[i])];
       const double friction = 0.5 * (friction_[pair.s] + friction_[pair.t]);
       if (!(friction > 0.0) || !(pair.push > 0.0 || pair.stop > 0.0))
         continue;

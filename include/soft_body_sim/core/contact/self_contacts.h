@@ -145,7 +145,7 @@ public:
   /// (state_archive.h); the links, faces and their radii are the scene's.
   void carry(StateArchive& archive)
   {
-    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, travel_, entry_, tick_,
+    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, travel_, entry_, near_index_, candidate_bound_, tick_,
             face_centre_, face_extent_, face_grid_, face_candidates_, near_faces_);
   }
 
@@ -259,13 +259,6 @@ private:
   /// Two links that may touch this sub-step, and what friction may still spend there.
   struct NearPair
   {
-    /// Whether the pair is near (its contact at the sub-step's start within the near radii), once looked at.
-    enum class Admission : std::uint8_t
-    {
-      Unknown,
-      Near,
-      Far
-    };
     std::uint32_t s, t;  ///< segment indices
     double push;         ///< [m] the normal passes' push apart, less what friction has cancelled / mu
     double stop;         ///< [m/s] the approach speed they removed, likewise
@@ -273,12 +266,16 @@ private:
     bool valid = false;  ///< that contact has a direction and a free node
     std::uint64_t seen = 0;
     double travel = 0.0;  ///< [m] its four nodes' travel_, summed, at tick `seen`
-    double bound = 0.0;   ///< [m] at most their least distance at the sub-step's start
-    Admission admission = Admission::Unknown;
 
-    void carry(StateArchive& archive) { archive(s, t, push, stop, contact, valid, seen, travel, bound, admission); }
+    void carry(StateArchive& archive) { archive(s, t, push, stop, contact, valid, seen, travel); }
   };
+  /// The near pairs of this sub-step, as the passes found them (resolve).
   std::vector<NearPair> near_;
+  /// per candidate: its place in near_, or kFar (not near this sub-step) or kUnknown (not looked at yet)
+  std::vector<std::int32_t> near_index_;
+  static constexpr std::int32_t kFar = -2, kUnknown = -1;
+  /// per candidate: at most its links' least distance at the sub-step's start [m]
+  std::vector<double> candidate_bound_;
   /// per node (global index): the tick_ of the last push that moved it
   std::vector<std::uint64_t> moved_at_;
   /// per node (global index): how far the passes of this resolve have moved it, summed [m] (from 0 for the
