@@ -154,10 +154,19 @@ std::optional<TunnellingRisk> tunnellingRisk(const SceneDef& scene, const StepSe
 World buildWorld(const SceneDef& scene)
 {
   int node_count = 0;
+  std::size_t spring_count = 0, constraint_count = 0;
   for (const BodyDef& body : scene.bodies)
+  {
     node_count += static_cast<int>(body.nodes.size());
+    spring_count += body.springs.size();
+    constraint_count += body.constraints.size();
+  }
 
   Model model;
+  // Their exact lengths: grown by doubling, a 100,000-node cloth's 596,000 springs held capacity for 1.75
+  // times as many (14.5 MB, 145 bytes a node, of memory_footprint's heap).
+  model.springs.reserve(spring_count);
+  model.constraints.reserve(constraint_count);
   model.gravity = scene.physics.gravity;
   model.drag = scene.physics.drag;
   model.colliders = scene.colliders;
