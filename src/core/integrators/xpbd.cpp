@@ -3,6 +3,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/elements/edge_colouring.h"
 #include "core/integrators/chain_contacts.h"
 #include "core/solvers/chain_solver.h"
 #include "core/integrators/integrator_kit.h"
@@ -42,6 +43,56 @@ void solveCell(const PressureCell& cell, const Eigen::VectorXd& inverse_mass, do
     x.col(cell.nodes[k]) += (inverse_mass[cell.nodes[k]] * delta_lambda) * g[k];
 }
 
+/// Rows updated at once by projectDistances: their arithmetic in Eigen's packets (two doubles each in
+/// SSE2), their gathers and scatters one by one.
+constexpr int kLanes = 4;
+using Lanes = Eigen::Array<double, kLanes, 1>;
+
+/// projectDistance on kLanes rows that share no node (one colour), lane by lane the same operations in the
+/// same order: the same bits as kLanes calls. `lambda` holds the rows' multipliers.
+void projectDistances(const SweepRow* rows, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+                      NodeArray& x, double* lambda)
+{
+  Lanes dx, dy, dz, mx, my, mz, rest_length, alpha_tilde, gamma, inverse_denominator;
+  for (int l = 0; l < kLanes; ++l)
+  {
+    const SweepRow& row = rows[l];
+    const Vec3 d = x.col(row.a) - x.col(row.b);
+    // The row's motion over this (sub)step, for the damping term (see projectDistance).
+    const Vec3 motion = (x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b));
+    dx[l] = d.x();
+    dy[l] = d.y();
+    dz[l] = d.z();
+    mx[l] = motion.x();
+    my[l] = motion.y();
+    mz[l] = motion.z();
+    rest_length[l] = row.rest_length;
+    alpha_tilde[l] = row.alpha_tilde;
+    gamma[l] = row.gamma;
+    inverse_denominator[l] = row.inverse_denominator;
+  }
+  const Lanes length = (dx * dx + dy * dy + dz * dz).sqrt();
+  const Lanes inverse_length = Lanes::Ones() / length;
+  const Lanes ux = dx * inverse_length;
+  const Lanes uy = dy * inverse_length;
+  const Lanes uz = dz * inverse_length;
+  const Lanes c = length - rest_length;
+  const Lanes c_rate_h = (gamma == 0.0).select(Lanes::Zero(), ux * mx + uy * my + uz * mz);
+  const Lanes old_lambda = Eigen::Map<const Lanes>(lambda);
+  const Lanes delta_lambda = (-c - alpha_tilde * old_lambda - gamma * c_rate_h) * inverse_denominator;
+  for (int l = 0; l < kLanes; ++l)
+  {
+    // As projectDistance: rows that cannot move, and coincident nodes (no direction), are left.
+    if (inverse_denominator[l] == 0.0 || length[l] < kMinSpringLength)
+      continue;
+    const SweepRow& row = rows[l];
+    lambda[l] += delta_lambda[l];
+    const Vec3 u(ux[l], uy[l], uz[l]);
+    x.col(row.a) += (inverse_mass[row.a] * delta_lambda[l]) * u;
+    x.col(row.b) -= (inverse_mass[row.b] * delta_lambda[l]) * u;
+  }
+}
+
 /// Extended position-based dynamics (Macklin, Mueller, Chentanez 2016), one call per sub-step as in
 /// "Small steps in physics simulation" (Macklin et al. 2019) and Ten Minute Physics:
 ///   preSolve:  v = v / (1 + h drag) + h g,  x_prev = x,  x += h v
@@ -61,7 +112,7 @@ public:
   /// The chain solver's buffers are made anew by every solve; the rest is carried.
   void carry(StateArchive& archive, const Model& /*model*/) override
   {
-    archive(order_, swept_count_, chain_starts_, ordered_nodes_, chain_contacts_, chain_heavy_, swept_chain_,
+    archive(order_, swept_count_, colour_starts_, last_colour_shares_nodes_, chain_starts_, ordered_nodes_, chain_contacts_, chain_heavy_, swept_chain_,
             correction_, chain_tension_, rows_, rows_h_, reorder_, lambda_, solved_h_, cell_lambda_);
     if (archive.reading())
       reserveChains();
@@ -153,8 +204,7 @@ private:
       }
       else
       {
-        for (std::size_t k = 0; k < swept_count_; ++k)
-          projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
+        sweepColours(model, x);
       }
       // Chains share no free node with the swept rows: each is one block of a block Gauss-Seidel, solved
       // exactly (one Newton step per iteration).
@@ -295,37 +345,34 @@ private:
     ordered_nodes_ = model.nodeCount();
   }
 
-  /// Appends `rows` (row indices, in model order) to order_ grouped by a greedy edge colouring, so that
-  /// no two rows of a colour share a node. In model order, consecutive rows of a rope or a cloth row
-  /// share a node, so each update waits for its predecessor's square root and divisions (~90 cycles);
-  /// within a colour the processor overlaps them. Gauss-Seidel in this order converges as fast as in
-  /// model order (both are consistent orderings; for a chain, red-black and lexicographic have the same
-  /// spectral radius).
+  /// Appends `rows` (row indices, in model order) to order_ grouped by a greedy edge colouring
+  /// (edgeColourOrder), and keeps where each colour starts for the sweep (sweepColours). Gauss-Seidel in
+  /// this order converges as fast as in model order (both are consistent orderings; for a chain, red-black
+  /// and lexicographic have the same spectral radius).
   void colourRows(const Model& model, const std::vector<std::pair<int, int>>& ends,
                   const std::vector<std::uint32_t>& rows)
   {
-    constexpr int kColours = 64;
-    std::vector<std::uint64_t> used(static_cast<std::size_t>(model.nodeCount()), 0);
-    std::vector<std::uint8_t> colour(rows.size());
-    std::size_t start[kColours + 1] = {};
-    for (std::size_t k = 0; k < rows.size(); ++k)
+    EdgeColouring colouring = edgeColourOrder(ends, rows, model.nodeCount());
+    order_ = std::move(colouring.order);
+    colour_starts_ = std::move(colouring.colour_starts);
+    last_colour_shares_nodes_ = colouring.last_shares_nodes;
+  }
+
+  /// One Gauss-Seidel sweep over the swept rows, colour by colour. The rows of a colour share no node, so
+  /// updating kLanes of them at once (projectDistances) is the same arithmetic in the same order as one by
+  /// one: the same bits.
+  void sweepColours(const Model& model, NodeArray& x)
+  {
+    for (std::size_t c = 0; c + 1 < colour_starts_.size(); ++c)
     {
-      const auto [a, b] = ends[rows[k]];
-      const std::uint64_t taken = used[static_cast<std::size_t>(a)] | used[static_cast<std::size_t>(b)];
-      // The first free colour; a node with 64 rows shares the last one (still correct, only slower).
-      int c = 0;
-      while (c < kColours - 1 && (taken >> c) & 1u)
-        ++c;
-      colour[k] = static_cast<std::uint8_t>(c);
-      used[static_cast<std::size_t>(a)] |= std::uint64_t{ 1 } << c;
-      used[static_cast<std::size_t>(b)] |= std::uint64_t{ 1 } << c;
-      ++start[c + 1];
+      std::size_t k = colour_starts_[c];
+      const std::size_t end = colour_starts_[c + 1];
+      if (!(last_colour_shares_nodes_ && c + 2 == colour_starts_.size()))
+        for (; k + kLanes <= end; k += kLanes)
+          projectDistances(&rows_[k], model.inverse_mass, previous_, x, lambda_.data() + k);
+      for (; k < end; ++k)
+        projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
     }
-    for (int c = 0; c < kColours; ++c)
-      start[c + 1] += start[c];
-    order_.resize(rows.size());
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      order_[start[colour[k]]++] = rows[k];
   }
 
   void postSolve(const Model& model, State& state, double h)
@@ -349,6 +396,8 @@ private:
   NodeArray previous_;
   std::vector<std::uint32_t> order_;  ///< solve order of the rows (see orderRows)
   std::size_t swept_count_ = 0;       ///< order_[0, swept_count_) are swept by Gauss-Seidel
+  std::vector<std::size_t> colour_starts_;  ///< the swept rows' colours (EdgeColouring::colour_starts)
+  bool last_colour_shares_nodes_ = false;   ///< EdgeColouring::last_shares_nodes of the swept rows
   std::vector<std::size_t> chain_starts_;  ///< chain c is order_[chain_starts_[c], chain_starts_[c + 1])
   int ordered_nodes_ = -1;
   ChainSolver chains_;
