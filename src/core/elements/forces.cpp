@@ -1,5 +1,6 @@
 #include "soft_body_sim/core/elements/forces.h"
 
+#include "core/elements/column_packets.h"
 #include "core/elements/edge_colouring.h"
 #include "core/elements/element_kinds.h"
 
@@ -14,14 +15,9 @@ namespace soft_body_sim
 {
 namespace
 {
-/// Springs updated at once: their arithmetic in Eigen's packets (two doubles each in SSE2), their
-/// gathers and scatters one by one.
-constexpr int kLanes = 4;
-using Lanes = Eigen::Array<double, kLanes, 1>;
-
 /// The force on end a per unit of d = x_a - x_b, the Spring law with u = d / |d| taken as one division:
 ///   F_a = -(k (|d| - rest_length) + c (v_a - v_b) . d / |d|) / |d|  d.
-/// `rate` is (v_a - v_b) . d [m^2/s] and `length` |d| [m]; T is a double or Lanes.
+/// `rate` is (v_a - v_b) . d [m^2/s] and `length` |d| [m]; T is a double or a Packet.
 template <typename T>
 T forcePerLength(const T& length, const T& rate, const T& rest_length, const T& stiffness, const T& damping)
 {
@@ -61,38 +57,43 @@ void accumulateSpringForces(const SpringArrays& springs, const NodeArray& x, con
   double* const sum = force.data();
   const std::size_t count = springs.size();
   std::size_t k = 0;
-  for (; k + kLanes <= count; k += kLanes)
+  // Two springs at once (Packet); their scatters go lane by lane, so that a pair across two colours that
+  // shares a node still adds both forces to it.
+  for (; k + 2 <= count; k += 2)
   {
-    Lanes dx, dy, dz, rate;
-    for (int l = 0; l < kLanes; ++l)
+    const std::ptrdiff_t a[2] = { springs.a[k], springs.a[k + 1] };
+    const std::ptrdiff_t b[2] = { springs.b[k], springs.b[k + 1] };
+    const ColumnPair x_a = loadColumns(position, a[0], a[1]);
+    const ColumnPair x_b = loadColumns(position, b[0], b[1]);
+    const ColumnPair v_a = loadColumns(velocity, a[0], a[1]);
+    const ColumnPair v_b = loadColumns(velocity, b[0], b[1]);
+    const Packet dx = x_a.x - x_b.x;
+    const Packet dy = x_a.y - x_b.y;
+    const Packet dz = x_a.z - x_b.z;
+    const Packet rate = (v_a.x - v_b.x) * dx + (v_a.y - v_b.y) * dy + (v_a.z - v_b.z) * dz;
+    const Packet length = Eigen::internal::psqrt(dx * dx + dy * dy + dz * dz);
+    const Packet per_length =
+        forcePerLength(length, rate, Eigen::internal::ploadu<Packet>(&springs.rest_length[k]),
+                       Eigen::internal::ploadu<Packet>(&springs.stiffness[k]),
+                       Eigen::internal::ploadu<Packet>(&springs.damping[k]));
+    const Packet f_x = per_length * dx;
+    const Packet f_y = per_length * dy;
+    // (f_x, f_y) of each spring
+    const Packet f_xy[2] = { Eigen::internal::vec2d_unpacklo(f_x, f_y), Eigen::internal::vec2d_unpackhi(f_x, f_y) };
+    alignas(16) double f_z[2];
+    alignas(16) double lengths[2];
+    Eigen::internal::pstore(f_z, per_length * dz);
+    Eigen::internal::pstore(lengths, length);
+    for (int l = 0; l < 2; ++l)
     {
-      const std::ptrdiff_t a = 3 * static_cast<std::ptrdiff_t>(springs.a[k + l]);
-      const std::ptrdiff_t b = 3 * static_cast<std::ptrdiff_t>(springs.b[k + l]);
-      dx[l] = position[a] - position[b];
-      dy[l] = position[a + 1] - position[b + 1];
-      dz[l] = position[a + 2] - position[b + 2];
-      rate[l] = (velocity[a] - velocity[b]) * dx[l] + (velocity[a + 1] - velocity[b + 1]) * dy[l] +
-                (velocity[a + 2] - velocity[b + 2]) * dz[l];
-    }
-    const Lanes length = (dx * dx + dy * dy + dz * dz).sqrt();
-    const Lanes per_length = forcePerLength<Lanes>(length, rate, Eigen::Map<const Lanes>(&springs.rest_length[k]),
-                                                   Eigen::Map<const Lanes>(&springs.stiffness[k]),
-                                                   Eigen::Map<const Lanes>(&springs.damping[k]));
-    for (int l = 0; l < kLanes; ++l)
-    {
-      if (length[l] < kMinSpringLength)
+      if (lengths[l] < kMinSpringLength)
         continue;  // coincident nodes: the direction is undefined
-      const std::ptrdiff_t a = 3 * static_cast<std::ptrdiff_t>(springs.a[k + l]);
-      const std::ptrdiff_t b = 3 * static_cast<std::ptrdiff_t>(springs.b[k + l]);
-      const double fx = per_length[l] * dx[l];
-      const double fy = per_length[l] * dy[l];
-      const double fz = per_length[l] * dz[l];
-      sum[a] += fx;
-      sum[a + 1] += fy;
-      sum[a + 2] += fz;
-      sum[b] -= fx;
-      sum[b + 1] -= fy;
-      sum[b + 2] -= fz;
+      double* const sum_a = sum + 3 * a[l];
+      double* const sum_b = sum + 3 * b[l];
+      Eigen::internal::pstoreu(sum_a, Eigen::internal::ploadu<Packet>(sum_a) + f_xy[l]);
+      Eigen::internal::pstoreu(sum_b, Eigen::internal::ploadu<Packet>(sum_b) - f_xy[l]);
+      sum_a[2] += f_z[l];
+      sum_b[2] -= f_z[l];
     }
   }
   for (; k < count; ++k)

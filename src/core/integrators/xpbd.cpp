@@ -3,6 +3,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/elements/column_packets.h"
 #include "core/elements/edge_colouring.h"
 #include "core/integrators/chain_contacts.h"
 #include "core/solvers/chain_solver.h"
@@ -43,53 +44,67 @@ void solveCell(const PressureCell& cell, const Eigen::VectorXd& inverse_mass, do
     x.col(cell.nodes[k]) += (inverse_mass[cell.nodes[k]] * delta_lambda) * g[k];
 }
 
-/// Rows updated at once by projectDistances: their arithmetic in Eigen's packets (two doubles each in
-/// SSE2), their gathers and scatters one by one.
-constexpr int kLanes = 4;
-using Lanes = Eigen::Array<double, kLanes, 1>;
+/// SweepRow's doubles lie this many apart from one row to the next (for Eigen's strided pgather).
+constexpr std::ptrdiff_t kRowStride = sizeof(SweepRow) / sizeof(double);
+static_assert(sizeof(SweepRow) % sizeof(double) == 0, "SweepRow's doubles must lie a whole number of doubles apart");
 
-/// projectDistance on kLanes rows that share no node (one colour), lane by lane the same operations in the
-/// same order: the same bits as kLanes calls. `lambda` holds the rows' multipliers.
-void projectDistances(const SweepRow* rows, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-                      NodeArray& x, double* lambda)
+/// projectDistance on two rows that share no node (of one colour), in one of Eigen's packets: lane by lane
+/// the same operations in the same order, so the same bits as two calls. `lambda` holds their multipliers.
+void projectDistancePair(const SweepRow* rows, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+                         NodeArray& x, double* lambda)
 {
-  Lanes dx, dy, dz, mx, my, mz, rest_length, alpha_tilde, gamma, inverse_denominator;
-  for (int l = 0; l < kLanes; ++l)
-  {
-    const SweepRow& row = rows[l];
-    const Vec3 d = x.col(row.a) - x.col(row.b);
-    // The row's motion over this (sub)step, for the damping term (see projectDistance).
-    const Vec3 motion = (x.col(row.a) - x_prev.col(row.a)) - (x.col(row.b) - x_prev.col(row.b));
-    dx[l] = d.x();
-    dy[l] = d.y();
-    dz[l] = d.z();
-    mx[l] = motion.x();
-    my[l] = motion.y();
-    mz[l] = motion.z();
-    rest_length[l] = row.rest_length;
-    alpha_tilde[l] = row.alpha_tilde;
-    gamma[l] = row.gamma;
-    inverse_denominator[l] = row.inverse_denominator;
-  }
-  const Lanes length = (dx * dx + dy * dy + dz * dz).sqrt();
-  const Lanes inverse_length = Lanes::Ones() / length;
-  const Lanes ux = dx * inverse_length;
-  const Lanes uy = dy * inverse_length;
-  const Lanes uz = dz * inverse_length;
-  const Lanes c = length - rest_length;
-  const Lanes c_rate_h = (gamma == 0.0).select(Lanes::Zero(), ux * mx + uy * my + uz * mz);
-  const Lanes old_lambda = Eigen::Map<const Lanes>(lambda);
-  const Lanes delta_lambda = (-c - alpha_tilde * old_lambda - gamma * c_rate_h) * inverse_denominator;
-  for (int l = 0; l < kLanes; ++l)
+  using Eigen::internal::pgather;
+  const std::ptrdiff_t a[2] = { rows[0].a, rows[1].a };
+  const std::ptrdiff_t b[2] = { rows[0].b, rows[1].b };
+  const ColumnPair x_a = loadColumns(x.data(), a[0], a[1]);
+  const ColumnPair x_b = loadColumns(x.data(), b[0], b[1]);
+  const ColumnPair previous_a = loadColumns(x_prev.data(), a[0], a[1]);
+  const ColumnPair previous_b = loadColumns(x_prev.data(), b[0], b[1]);
+  const Packet dx = x_a.x - x_b.x;
+  const Packet dy = x_a.y - x_b.y;
+  const Packet dz = x_a.z - x_b.z;
+  const Packet length = Eigen::internal::psqrt(dx * dx + dy * dy + dz * dz);
+  const Packet inverse_length = 1.0 / length;
+  const Packet ux = dx * inverse_length;
+  const Packet uy = dy * inverse_length;
+  const Packet uz = dz * inverse_length;
+  const Packet gamma = pgather<double, Packet>(&rows[0].gamma, kRowStride);
+  // gradC . (x - x_prev), and 0 without damping (as projectDistance).
+  const Packet rate_h = ux * ((x_a.x - previous_a.x) - (x_b.x - previous_b.x)) +
+                        uy * ((x_a.y - previous_a.y) - (x_b.y - previous_b.y)) +
+                        uz * ((x_a.z - previous_a.z) - (x_b.z - previous_b.z));
+  const Packet zero = Eigen::internal::pzero(gamma);
+  const Packet c_rate_h = Eigen::internal::pselect(Eigen::internal::pcmp_eq(gamma, zero), zero, rate_h);
+  const Packet c = length - pgather<double, Packet>(&rows[0].rest_length, kRowStride);
+  const Packet inverse_denominator = pgather<double, Packet>(&rows[0].inverse_denominator, kRowStride);
+  const Packet delta_lambda = (-c - pgather<double, Packet>(&rows[0].alpha_tilde, kRowStride) *
+                                        Eigen::internal::ploadu<Packet>(lambda) -
+                               gamma * c_rate_h) *
+                              inverse_denominator;
+  alignas(16) double lanes[4][2];  // delta lambda, u_z, 1 / denominator, |d| of each row
+  Eigen::internal::pstore(lanes[0], delta_lambda);
+  Eigen::internal::pstore(lanes[1], uz);
+  Eigen::internal::pstore(lanes[2], inverse_denominator);
+  Eigen::internal::pstore(lanes[3], length);
+  // (u_x, u_y) of each row
+  const Packet u_xy[2] = { Eigen::internal::vec2d_unpacklo(ux, uy), Eigen::internal::vec2d_unpackhi(ux, uy) };
+  double* const position = x.data();
+  for (int l = 0; l < 2; ++l)
   {
     // As projectDistance: rows that cannot move, and coincident nodes (no direction), are left.
-    if (inverse_denominator[l] == 0.0 || length[l] < kMinSpringLength)
+    if (lanes[2][l] == 0.0 || lanes[3][l] < kMinSpringLength)
       continue;
-    const SweepRow& row = rows[l];
-    lambda[l] += delta_lambda[l];
-    const Vec3 u(ux[l], uy[l], uz[l]);
-    x.col(row.a) += (inverse_mass[row.a] * delta_lambda[l]) * u;
-    x.col(row.b) -= (inverse_mass[row.b] * delta_lambda[l]) * u;
+    lambda[l] += lanes[0][l];
+    const double move_a = inverse_mass[a[l]] * lanes[0][l];
+    const double move_b = inverse_mass[b[l]] * lanes[0][l];
+    double* const column_a = position + 3 * a[l];
+    double* const column_b = position + 3 * b[l];
+    Eigen::internal::pstoreu(column_a,
+                             Eigen::internal::ploadu<Packet>(column_a) + Eigen::internal::pset1<Packet>(move_a) * u_xy[l]);
+    Eigen::internal::pstoreu(column_b,
+                             Eigen::internal::ploadu<Packet>(column_b) - Eigen::internal::pset1<Packet>(move_b) * u_xy[l]);
+    column_a[2] += move_a * lanes[1][l];
+    column_b[2] -= move_b * lanes[1][l];
   }
 }
 
@@ -359,7 +374,7 @@ private:
   }
 
   /// One Gauss-Seidel sweep over the swept rows, colour by colour. The rows of a colour share no node, so
-  /// updating kLanes of them at once (projectDistances) is the same arithmetic in the same order as one by
+  /// updating two of them at once (projectDistancePair) is the same arithmetic in the same order as one by
   /// one: the same bits.
   void sweepColours(const Model& model, NodeArray& x)
   {
@@ -368,8 +383,8 @@ private:
       std::size_t k = colour_starts_[c];
       const std::size_t end = colour_starts_[c + 1];
       if (!(last_colour_shares_nodes_ && c + 2 == colour_starts_.size()))
-        for (; k + kLanes <= end; k += kLanes)
-          projectDistances(&rows_[k], model.inverse_mass, previous_, x, lambda_.data() + k);
+        for (; k + 2 <= end; k += 2)
+          projectDistancePair(&rows_[k], model.inverse_mass, previous_, x, lambda_.data() + k);
       for (; k < end; ++k)
         projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
     }
