@@ -99,10 +99,10 @@ void projectDistancePair(const SweepRow* rows, const Eigen::VectorXd& inverse_ma
     const double move_b = inverse_mass[b[l]] * lanes[0][l];
     double* const column_a = position + 3 * a[l];
     double* const column_b = position + 3 * b[l];
-    Eigen::internal::pstoreu(column_a,
-                             Eigen::internal::ploadu<Packet>(column_a) + Eigen::internal::pset1<Packet>(move_a) * u_xy[l]);
-    Eigen::internal::pstoreu(column_b,
-                             Eigen::internal::ploadu<Packet>(column_b) - Eigen::internal::pset1<Packet>(move_b) * u_xy[l]);
+    const Packet step_a = Eigen::internal::pset1<Packet>(move_a) * u_xy[l];
+    const Packet step_b = Eigen::internal::pset1<Packet>(move_b) * u_xy[l];
+    Eigen::internal::pstoreu(column_a, Eigen::internal::ploadu<Packet>(column_a) + step_a);
+    Eigen::internal::pstoreu(column_b, Eigen::internal::ploadu<Packet>(column_b) - step_b);
     column_a[2] += move_a * lanes[1][l];
     column_b[2] -= move_b * lanes[1][l];
   }
@@ -127,8 +127,9 @@ public:
   /// The chain solver's buffers are made anew by every solve; the rest is carried.
   void carry(StateArchive& archive, const Model& /*model*/) override
   {
-    archive(order_, swept_count_, colour_starts_, last_colour_shares_nodes_, chain_starts_, ordered_nodes_, chain_contacts_, chain_heavy_, swept_chain_,
-            correction_, chain_tension_, rows_, rows_h_, reorder_, lambda_, solved_h_, cell_lambda_);
+    archive(order_, swept_count_, colour_starts_, last_colour_shares_nodes_, chain_starts_, ordered_nodes_,
+            chain_contacts_, chain_heavy_, swept_chain_, correction_, chain_tension_, rows_, rows_h_, reorder_, lambda_,
+            solved_h_, cell_lambda_);
     if (archive.reading())
       reserveChains();
   }
