@@ -1,26 +1,115 @@
 #include "soft_body_sim/core/elements/forces.h"
 
+#include "core/elements/column_packets.h"
+#include "core/elements/edge_colouring.h"
 #include "core/elements/element_kinds.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <Eigen/Geometry>
 
 namespace soft_body_sim
 {
-void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force)
+namespace
 {
+/// The force on end a per unit of d = x_a - x_b, the Spring law with u = d / |d| taken as one division:
+///   F_a = -(k (|d| - rest_length) + c (v_a - v_b) . d / |d|) / |d|  d.
+/// `rate` is (v_a - v_b) . d [m^2/s] and `length` |d| [m]; T is a double or a Packet.
+template <typename T>
+T forcePerLength(const T& length, const T& rate, const T& rest_length, const T& stiffness, const T& damping)
+{
+  const T inverse_length = 1.0 / length;
+  return -(stiffness * (length - rest_length) + damping * rate * inverse_length) * inverse_length;
+}
+}  // namespace
+
+SpringArrays springArrays(const Model& model)
+{
+  std::vector<std::pair<int, int>> ends;
+  ends.reserve(model.springs.size());
   for (const Spring& s : model.springs)
+    ends.emplace_back(s.a, s.b);
+  std::vector<std::uint32_t> rows(model.springs.size());
+  for (std::size_t k = 0; k < rows.size(); ++k)
+    rows[k] = static_cast<std::uint32_t>(k);
+  SpringArrays arrays;
+  for (const std::uint32_t k : edgeColourOrder(ends, rows, model.nodeCount()).order)
   {
-    Vec3 u;
-    double length;
-    if (!springAxis(x, s.a, s.b, u, length))
+    const Spring& s = model.springs[k];
+    arrays.a.push_back(s.a);
+    arrays.b.push_back(s.b);
+    arrays.rest_length.push_back(s.rest_length);
+    arrays.stiffness.push_back(s.stiffness);
+    arrays.damping.push_back(s.damping);
+  }
+  return arrays;
+}
+
+void accumulateSpringForces(const SpringArrays& springs, const NodeArray& x, const NodeArray& v, NodeArray& force)
+{
+  // The columns through plain pointers: a store through force.col() may alias force's own data pointer,
+  // which the compiler would load again after every store.
+  const double* const position = x.data();
+  const double* const velocity = v.data();
+  double* const sum = force.data();
+  const std::size_t count = springs.size();
+  std::size_t k = 0;
+  // Two springs at once (Packet); their scatters go lane by lane, so that a pair across two colours that
+  // shares a node still adds both forces to it.
+  for (; k + 2 <= count; k += 2)
+  {
+    const std::ptrdiff_t a[2] = { springs.a[k], springs.a[k + 1] };
+    const std::ptrdiff_t b[2] = { springs.b[k], springs.b[k + 1] };
+    const ColumnPair x_a = loadColumns(position, a[0], a[1]);
+    const ColumnPair x_b = loadColumns(position, b[0], b[1]);
+    const ColumnPair v_a = loadColumns(velocity, a[0], a[1]);
+    const ColumnPair v_b = loadColumns(velocity, b[0], b[1]);
+    const Packet dx = x_a.x - x_b.x;
+    const Packet dy = x_a.y - x_b.y;
+    const Packet dz = x_a.z - x_b.z;
+    const Packet rate = (v_a.x - v_b.x) * dx + (v_a.y - v_b.y) * dy + (v_a.z - v_b.z) * dz;
+    const Packet length = Eigen::internal::psqrt(dx * dx + dy * dy + dz * dz);
+    const Packet per_length =
+        forcePerLength(length, rate, Eigen::internal::ploadu<Packet>(&springs.rest_length[k]),
+                       Eigen::internal::ploadu<Packet>(&springs.stiffness[k]),
+                       Eigen::internal::ploadu<Packet>(&springs.damping[k]));
+    const Packet f_x = per_length * dx;
+    const Packet f_y = per_length * dy;
+    // (f_x, f_y) of each spring
+    const Packet f_xy[2] = { Eigen::internal::vec2d_unpacklo(f_x, f_y), Eigen::internal::vec2d_unpackhi(f_x, f_y) };
+    alignas(16) double f_z[2];
+    alignas(16) double lengths[2];
+    Eigen::internal::pstore(f_z, per_length * dz);
+    Eigen::internal::pstore(lengths, length);
+    for (int l = 0; l < 2; ++l)
+    {
+      if (lengths[l] < kMinSpringLength)
+        continue;  // coincident nodes: the direction is undefined
+      double* const sum_a = sum + 3 * a[l];
+      double* const sum_b = sum + 3 * b[l];
+      Eigen::internal::pstoreu(sum_a, Eigen::internal::ploadu<Packet>(sum_a) + f_xy[l]);
+      Eigen::internal::pstoreu(sum_b, Eigen::internal::ploadu<Packet>(sum_b) - f_xy[l]);
+      sum_a[2] += f_z[l];
+      sum_b[2] -= f_z[l];
+    }
+  }
+  for (; k < count; ++k)
+  {
+    const int a = springs.a[k];
+    const int b = springs.b[k];
+    const Vec3 d = x.col(a) - x.col(b);
+    const double length = std::sqrt(d.x() * d.x() + d.y() * d.y() + d.z() * d.z());
+    if (length < kMinSpringLength)
       continue;
-    const Vec3 f = -springTension(s, u, length, v) * u;
-    force.col(s.a) += f;
-    force.col(s.b) -= f;
+    const Vec3 dv = v.col(a) - v.col(b);
+    const double rate = dv.x() * d.x() + dv.y() * d.y() + dv.z() * d.z();
+    const Vec3 f =
+        forcePerLength(length, rate, springs.rest_length[k], springs.stiffness[k], springs.damping[k]) * d;
+    force.col(a) += f;
+    force.col(b) -= f;
   }
 }
 
@@ -69,11 +158,11 @@ void accumulatePressureForces(const Model& model, const NodeArray& x, NodeArray&
   }
 }
 
-void computeAccelerations(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force,
-                          NodeArray& acceleration)
+void computeAccelerations(const Model& model, const SpringArrays& springs, const NodeArray& x, const NodeArray& v,
+                          NodeArray& force, NodeArray& acceleration)
 {
   force.setZero(3, x.cols());
-  accumulateSpringForces(model, x, v, force);
+  accumulateSpringForces(springs, x, v, force);
   if (!model.cells.empty())
     accumulatePressureForces(model, x, force);
   acceleration.resize(3, x.cols());

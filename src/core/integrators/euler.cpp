@@ -21,7 +21,7 @@ public:
   bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
   void step(const Model& model, State& state, double h, int iterations) override
   {
-    computeAccelerations(model, state.position, state.velocity, force_, acceleration_);
+    accelerations(model, state.position, state.velocity, force_, acceleration_);
     for (int i = 0; i < model.nodeCount(); ++i)
     {
       if (!model.isFree(i))

@@ -124,9 +124,28 @@ public:
     constraints_.tensions(model, forces.tension.tail(static_cast<Eigen::Index>(model.constraints.size())));
   }
   void carry(StateArchive& archive, const Model& /*model*/) override { archive(constraints_); }
+  /// The springs' arrays are made again for the changed model (their parameters, their ends).
+  void modelChanged() override
+  {
+    springs_ = SpringArrays{};
+    invalidate();
+  }
 
 protected:
+  /// computeAccelerations with the springs' arrays (springArrays), made at the first call and again after
+  /// the model changed. Not carried: a restored world makes the same arrays from its model.
+  void accelerations(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force,
+                     NodeArray& acceleration)
+  {
+    if (springs_.size() != model.springs.size())
+      springs_ = springArrays(model);
+    computeAccelerations(model, springs_, x, v, force, acceleration);
+  }
+
   ConstraintPass constraints_;
+
+private:
+  SpringArrays springs_;
 };
 
 std::unique_ptr<Integrator> makeExplicitEuler();

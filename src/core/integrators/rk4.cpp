@@ -19,16 +19,16 @@ public:
   {
     const NodeArray& x = state.position;
     const NodeArray& v = state.velocity;
-    computeAccelerations(model, x, v, force_, a1_);
+    accelerations(model, x, v, force_, a1_);
     stage_x_ = x + 0.5 * h * v;
     v2_ = v + 0.5 * h * a1_;
-    computeAccelerations(model, stage_x_, v2_, force_, a2_);
+    accelerations(model, stage_x_, v2_, force_, a2_);
     stage_x_ = x + 0.5 * h * v2_;
     v3_ = v + 0.5 * h * a2_;
-    computeAccelerations(model, stage_x_, v3_, force_, a3_);
+    accelerations(model, stage_x_, v3_, force_, a3_);
     stage_x_ = x + h * v3_;
     v4_ = v + h * a3_;
-    computeAccelerations(model, stage_x_, v4_, force_, a4_);
+    accelerations(model, stage_x_, v4_, force_, a4_);
     for (int i = 0; i < model.nodeCount(); ++i)
     {
       if (!model.isFree(i))

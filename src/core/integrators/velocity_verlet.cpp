@@ -23,7 +23,7 @@ public:
   void step(const Model& model, State& state, double h, int iterations) override
   {
     if (!has_acceleration_)
-      computeAccelerations(model, state.position, state.velocity, force_, acceleration_);
+      accelerations(model, state.position, state.velocity, force_, acceleration_);
     predicted_velocity_ = state.velocity;
     for (int i = 0; i < model.nodeCount(); ++i)
     {
@@ -33,7 +33,7 @@ public:
       state.velocity.col(i) += 0.5 * h * acceleration_.col(i);
       state.position.col(i) += h * state.velocity.col(i);
     }
-    computeAccelerations(model, state.position, predicted_velocity_, force_, acceleration_);
+    accelerations(model, state.position, predicted_velocity_, force_, acceleration_);
     for (int i = 0; i < model.nodeCount(); ++i)
       if (model.isFree(i))
         state.velocity.col(i) += 0.5 * h * acceleration_.col(i);

@@ -27,7 +27,7 @@ public:
   }
   void step(const Model& model, State& state, double h, int iterations) override
   {
-    computeAccelerations(model, state.position, state.velocity, force_, acceleration_);
+    accelerations(model, state.position, state.velocity, force_, acceleration_);
     if (!has_history_ || h != h_)
       previous_acceleration_ = acceleration_;
     start_ = state.position;

@@ -3,6 +3,8 @@
 #include <utility>
 #include <vector>
 
+#include "core/elements/column_packets.h"
+#include "core/elements/edge_colouring.h"
 #include "core/integrators/chain_contacts.h"
 #include "core/solvers/chain_solver.h"
 #include "core/integrators/integrator_kit.h"
@@ -42,6 +44,70 @@ void solveCell(const PressureCell& cell, const Eigen::VectorXd& inverse_mass, do
     x.col(cell.nodes[k]) += (inverse_mass[cell.nodes[k]] * delta_lambda) * g[k];
 }
 
+/// SweepRow's doubles lie this many apart from one row to the next (for Eigen's strided pgather).
+constexpr std::ptrdiff_t kRowStride = sizeof(SweepRow) / sizeof(double);
+static_assert(sizeof(SweepRow) % sizeof(double) == 0, "SweepRow's doubles must lie a whole number of doubles apart");
+
+/// projectDistance on two rows that share no node (of one colour), in one of Eigen's packets: lane by lane
+/// the same operations in the same order, so the same bits as two calls. `lambda` holds their multipliers.
+void projectDistancePair(const SweepRow* rows, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+                         NodeArray& x, double* lambda)
+{
+  using Eigen::internal::pgather;
+  const std::ptrdiff_t a[2] = { rows[0].a, rows[1].a };
+  const std::ptrdiff_t b[2] = { rows[0].b, rows[1].b };
+  const ColumnPair x_a = loadColumns(x.data(), a[0], a[1]);
+  const ColumnPair x_b = loadColumns(x.data(), b[0], b[1]);
+  const ColumnPair previous_a = loadColumns(x_prev.data(), a[0], a[1]);
+  const ColumnPair previous_b = loadColumns(x_prev.data(), b[0], b[1]);
+  const Packet dx = x_a.x - x_b.x;
+  const Packet dy = x_a.y - x_b.y;
+  const Packet dz = x_a.z - x_b.z;
+  const Packet length = Eigen::internal::psqrt(dx * dx + dy * dy + dz * dz);
+  const Packet inverse_length = 1.0 / length;
+  const Packet ux = dx * inverse_length;
+  const Packet uy = dy * inverse_length;
+  const Packet uz = dz * inverse_length;
+  const Packet gamma = pgather<double, Packet>(&rows[0].gamma, kRowStride);
+  // gradC . (x - x_prev), and 0 without damping (as projectDistance).
+  const Packet rate_h = ux * ((x_a.x - previous_a.x) - (x_b.x - previous_b.x)) +
+                        uy * ((x_a.y - previous_a.y) - (x_b.y - previous_b.y)) +
+                        uz * ((x_a.z - previous_a.z) - (x_b.z - previous_b.z));
+  const Packet zero = Eigen::internal::pzero(gamma);
+  const Packet c_rate_h = Eigen::internal::pselect(Eigen::internal::pcmp_eq(gamma, zero), zero, rate_h);
+  const Packet c = length - pgather<double, Packet>(&rows[0].rest_length, kRowStride);
+  const Packet inverse_denominator = pgather<double, Packet>(&rows[0].inverse_denominator, kRowStride);
+  const Packet delta_lambda = (-c - pgather<double, Packet>(&rows[0].alpha_tilde, kRowStride) *
+                                        Eigen::internal::ploadu<Packet>(lambda) -
+                               gamma * c_rate_h) *
+                              inverse_denominator;
+  alignas(16) double lanes[4][2];  // delta lambda, u_z, 1 / denominator, |d| of each row
+  Eigen::internal::pstore(lanes[0], delta_lambda);
+  Eigen::internal::pstore(lanes[1], uz);
+  Eigen::internal::pstore(lanes[2], inverse_denominator);
+  Eigen::internal::pstore(lanes[3], length);
+  // (u_x, u_y) of each row
+  const Packet u_xy[2] = { Eigen::internal::vec2d_unpacklo(ux, uy), Eigen::internal::vec2d_unpackhi(ux, uy) };
+  double* const position = x.data();
+  for (int l = 0; l < 2; ++l)
+  {
+    // As projectDistance: rows that cannot move, and coincident nodes (no direction), are left.
+    if (lanes[2][l] == 0.0 || lanes[3][l] < kMinSpringLength)
+      continue;
+    lambda[l] += lanes[0][l];
+    const double move_a = inverse_mass[a[l]] * lanes[0][l];
+    const double move_b = inverse_mass[b[l]] * lanes[0][l];
+    double* const column_a = position + 3 * a[l];
+    double* const column_b = position + 3 * b[l];
+    const Packet step_a = Eigen::internal::pset1<Packet>(move_a) * u_xy[l];
+    const Packet step_b = Eigen::internal::pset1<Packet>(move_b) * u_xy[l];
+    Eigen::internal::pstoreu(column_a, Eigen::internal::ploadu<Packet>(column_a) + step_a);
+    Eigen::internal::pstoreu(column_b, Eigen::internal::ploadu<Packet>(column_b) - step_b);
+    column_a[2] += move_a * lanes[1][l];
+    column_b[2] -= move_b * lanes[1][l];
+  }
+}
+
 /// Extended position-based dynamics (Macklin, Mueller, Chentanez 2016), one call per sub-step as in
 /// "Small steps in physics simulation" (Macklin et al. 2019) and Ten Minute Physics:
 ///   preSolve:  v = v / (1 + h drag) + h g,  x_prev = x,  x += h v
@@ -61,8 +127,9 @@ public:
   /// The chain solver's buffers are made anew by every solve; the rest is carried.
   void carry(StateArchive& archive, const Model& /*model*/) override
   {
-    archive(order_, swept_count_, chain_starts_, ordered_nodes_, chain_contacts_, chain_heavy_, swept_chain_,
-            correction_, chain_tension_, rows_, rows_h_, reorder_, lambda_, solved_h_, cell_lambda_);
+    archive(order_, swept_count_, colour_starts_, last_colour_shares_nodes_, chain_starts_, ordered_nodes_,
+            chain_contacts_, chain_heavy_, swept_chain_, correction_, chain_tension_, rows_, rows_h_, reorder_, lambda_,
+            solved_h_, cell_lambda_);
     if (archive.reading())
       reserveChains();
   }
@@ -153,8 +220,7 @@ private:
       }
       else
       {
-        for (std::size_t k = 0; k < swept_count_; ++k)
-          projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
+        sweepColours(model, x);
       }
       // Chains share no free node with the swept rows: each is one block of a block Gauss-Seidel, solved
       // exactly (one Newton step per iteration).
@@ -295,37 +361,34 @@ private:
     ordered_nodes_ = model.nodeCount();
   }
 
-  /// Appends `rows` (row indices, in model order) to order_ grouped by a greedy edge colouring, so that
-  /// no two rows of a colour share a node. In model order, consecutive rows of a rope or a cloth row
-  /// share a node, so each update waits for its predecessor's square root and divisions (~90 cycles);
-  /// within a colour the processor overlaps them. Gauss-Seidel in this order converges as fast as in
-  /// model order (both are consistent orderings; for a chain, red-black and lexicographic have the same
-  /// spectral radius).
+  /// Appends `rows` (row indices, in model order) to order_ grouped by a greedy edge colouring
+  /// (edgeColourOrder), and keeps where each colour starts for the sweep (sweepColours). Gauss-Seidel in
+  /// this order converges as fast as in model order (both are consistent orderings; for a chain, red-black
+  /// and lexicographic have the same spectral radius).
   void colourRows(const Model& model, const std::vector<std::pair<int, int>>& ends,
                   const std::vector<std::uint32_t>& rows)
   {
-    constexpr int kColours = 64;
-    std::vector<std::uint64_t> used(static_cast<std::size_t>(model.nodeCount()), 0);
-    std::vector<std::uint8_t> colour(rows.size());
-    std::size_t start[kColours + 1] = {};
-    for (std::size_t k = 0; k < rows.size(); ++k)
+    EdgeColouring colouring = edgeColourOrder(ends, rows, model.nodeCount());
+    order_ = std::move(colouring.order);
+    colour_starts_ = std::move(colouring.colour_starts);
+    last_colour_shares_nodes_ = colouring.last_shares_nodes;
+  }
+
+  /// One Gauss-Seidel sweep over the swept rows, colour by colour. The rows of a colour share no node, so
+  /// updating two of them at once (projectDistancePair) is the same arithmetic in the same order as one by
+  /// one: the same bits.
+  void sweepColours(const Model& model, NodeArray& x)
+  {
+    for (std::size_t c = 0; c + 1 < colour_starts_.size(); ++c)
     {
-      const auto [a, b] = ends[rows[k]];
-      const std::uint64_t taken = used[static_cast<std::size_t>(a)] | used[static_cast<std::size_t>(b)];
-      // The first free colour; a node with 64 rows shares the last one (still correct, only slower).
-      int c = 0;
-      while (c < kColours - 1 && (taken >> c) & 1u)
-        ++c;
-      colour[k] = static_cast<std::uint8_t>(c);
-      used[static_cast<std::size_t>(a)] |= std::uint64_t{ 1 } << c;
-      used[static_cast<std::size_t>(b)] |= std::uint64_t{ 1 } << c;
-      ++start[c + 1];
+      std::size_t k = colour_starts_[c];
+      const std::size_t end = colour_starts_[c + 1];
+      if (!(last_colour_shares_nodes_ && c + 2 == colour_starts_.size()))
+        for (; k + 2 <= end; k += 2)
+          projectDistancePair(&rows_[k], model.inverse_mass, previous_, x, lambda_.data() + k);
+      for (; k < end; ++k)
+        projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
     }
-    for (int c = 0; c < kColours; ++c)
-      start[c + 1] += start[c];
-    order_.resize(rows.size());
-    for (std::size_t k = 0; k < rows.size(); ++k)
-      order_[start[colour[k]]++] = rows[k];
   }
 
   void postSolve(const Model& model, State& state, double h)
@@ -349,6 +412,8 @@ private:
   NodeArray previous_;
   std::vector<std::uint32_t> order_;  ///< solve order of the rows (see orderRows)
   std::size_t swept_count_ = 0;       ///< order_[0, swept_count_) are swept by Gauss-Seidel
+  std::vector<std::size_t> colour_starts_;  ///< the swept rows' colours (EdgeColouring::colour_starts)
+  bool last_colour_shares_nodes_ = false;   ///< EdgeColouring::last_shares_nodes of the swept rows
   std::vector<std::size_t> chain_starts_;  ///< chain c is order_[chain_starts_[c], chain_starts_[c + 1])
   int ordered_nodes_ = -1;
   ChainSolver chains_;

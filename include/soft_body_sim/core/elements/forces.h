@@ -1,6 +1,9 @@
 // Force and energy kernels shared by every force-based integrator.
 #pragma once
 
+#include <cstddef>
+#include <vector>
+
 #include "soft_body_sim/core/model.h"
 
 namespace soft_body_sim
@@ -28,8 +31,24 @@ inline double springTension(const Spring& s, const Vec3& u, double length, const
   return s.stiffness * (length - s.rest_length) + s.damping * (v.col(s.a) - v.col(s.b)).dot(u);
 }
 
+/// The model's springs as accumulateSpringForces reads them: one array per field, in the order of a greedy
+/// edge colouring, so that no two consecutive springs share a node (in model order each `force.col(a) += f`
+/// of a rope or a cloth waits for the previous spring's store to the same node). A copy of the springs'
+/// parameters: made again when the model changes.
+struct SpringArrays
+{
+  std::vector<int> a;
+  std::vector<int> b;
+  std::vector<double> rest_length;  ///< [m]
+  std::vector<double> stiffness;    ///< k [N/m]
+  std::vector<double> damping;      ///< c [N s/m]
+
+  std::size_t size() const { return a.size(); }
+};
+SpringArrays springArrays(const Model& model);
+
 /// Adds every spring's Hooke + dashpot force [N] to `force` (see Spring).
-void accumulateSpringForces(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force);
+void accumulateSpringForces(const SpringArrays& springs, const NodeArray& x, const NodeArray& v, NodeArray& force);
 
 /// Below this fraction a of its rest area (a cell) or volume (a tetrahedron) a gas's law continues as a
 /// parabola (see BoyleGas).
@@ -84,10 +103,10 @@ CellGas cellGas(const PressureCell& cell, double area);
 void accumulatePressureForces(const Model& model, const NodeArray& x, NodeArray& force);
 
 /// a(x, v) [m/s^2] of the model: gravity + F/m - drag v on free nodes, 0 on pinned ones; F is the
-/// springs' force plus, when the model has cells, their pressure.
+/// springs' force (`springs`: springArrays(model)) plus, when the model has cells, their pressure.
 /// `force` is caller-owned scratch space so that the hot loop never allocates.
-void computeAccelerations(const Model& model, const NodeArray& x, const NodeArray& v, NodeArray& force,
-                          NodeArray& acceleration);
+void computeAccelerations(const Model& model, const SpringArrays& springs, const NodeArray& x, const NodeArray& v,
+                          NodeArray& force, NodeArray& acceleration);
 
 /// Kinetic [J] of the free nodes.
 double kineticEnergy(const Model& model, const State& state);
