@@ -123,7 +123,14 @@ public:
     stateInternalForces(model, state, forces);
     constraints_.tensions(model, forces.tension.tail(static_cast<Eigen::Index>(model.constraints.size())));
   }
-  void carry(StateArchive& archive, const Model& /*model*/) override { archive(constraints_); }
+  /// The springs' arrays are not carried: read into a world whose model had other springs (another
+  /// material scaling), they are made again from the model read.
+  void carry(StateArchive& archive, const Model& /*model*/) override
+  {
+    archive(constraints_);
+    if (archive.reading())
+      springs_ = SpringArrays{};
+  }
   /// The springs' arrays are made again for the changed model (their parameters, their ends).
   void modelChanged() override
   {
