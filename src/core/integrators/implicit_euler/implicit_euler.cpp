@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -36,7 +37,8 @@ void forEachOf(Tuple& tuple, F&& f)
 ///   (M - h D - h^2 K) dv = h f(x_lin, v_k) + h K (x_n + h v_k - x_lin) - M (v_k - v_n)
 /// with K = df/dx, D = df/dv (BlockSystem: directly, block tridiagonally on chains or by a sparse LDL^T, or
 /// by preconditioned conjugate gradients, whichever costs less). The first iteration linearises at
-/// x_lin = x_n (exactly Baraff & Witkin's step); later ones at x_lin = x_n + h v_k. Every element kind adds
+/// x_lin = x_n (exactly Baraff & Witkin's step); later ones at x_lin = x_n + h v_k. The iterations go on until
+/// the step's equations hold to a tolerance, within a cap (NewtonRule, integrator_kit.h). Every element kind adds
 /// its forces and blocks (newton_system.h; springs, gas cells, rods and tetrahedra each say how they keep
 /// A symmetric positive definite), the damping force's dependence on x neglected, as in Baraff & Witkin;
 /// distance constraints are projected after the solve (the constraint pass). Unconditionally stable on a
@@ -87,6 +89,10 @@ public:
     contacts_ = nullptr;
   }
 
+  /// Newton's iterations until the step's equations hold (NewtonRule, integrator_kit.h): at least
+  /// `iterations`, at most NewtonRule::kMostIterations (or `iterations`). After each solve, the system is
+  /// assembled at the new iterate, whose right-hand side is then the residual h f(x_n + h v_k, v_k) -
+  /// M (v_k - v_n) (holds included); if it is small enough the step ends there, its solve spared.
   void step(const Model& model, State& state, double h, int iterations) override
   {
     const int n = model.nodeCount();
@@ -94,40 +100,41 @@ public:
     start_v_ = state.velocity;
     if (!analyzed_)
       analyze(model);
-    int planned = iterations;
-    for (int k = 0; k < planned; ++k)
+    const int most = std::max(iterations, NewtonRule::kMostIterations);
+    int solves = 0, missed_face_passes = 0;
+    // x_lin = x_n and the offset h v_n at which K acts on the first iteration (Baraff and Witkin's step).
+    offset_.setZero(3, n);
+    for (int i = 0; i < n; ++i)
+      if (model.isFree(i))
+        offset_.col(i) = h * state.velocity.col(i);
+    assemble(NewtonPoint{ model, start_x_, state.velocity, state.twist, offset_, h }, true);
+    for (;;)
     {
-      const NodeArray& v_k = state.velocity;
-      // x_lin and the offset x_n + h v_k - x_lin at which K acts: x_lin = x_n on the first iteration (the
-      // offset h v_k), x_n + h v_k on the others (no offset).
-      offset_.setZero(3, n);
-      if (k > 0)
-        linear_x_ = start_x_;
-      for (int i = 0; i < n; ++i)
-      {
-        if (!model.isFree(i))
-          continue;
-        if (k == 0)
-          offset_.col(i) = h * v_k.col(i);
-        else
-          linear_x_.col(i) += h * v_k.col(i);
-      }
-      assemble(NewtonPoint{ model, k == 0 ? start_x_ : linear_x_, v_k, state.twist, offset_, h }, k == 0);
       solve(model);
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
           state.velocity.col(i) += delta_v_.col(i);
+      ++solves;
+      if (solves >= most + missed_face_passes)
+        break;
+      if (contacts_ != nullptr)
+        collider_holds_.letGoPulling(h, delta_v_);
+      surface_holds_.letGoPulling(h, delta_v_);
+      assembleAtIterate(model, state, h);
+      if (solves < iterations || !converged(model, state.velocity, h))
+        continue;
       // One more iteration where the velocities carry a triangle into a collider that no hold holds off
       // (findMissedFaces), at most kMissedFacePasses more.
-      if (k + 1 == planned && planned < iterations + kMissedFacePasses && contacts_ != nullptr &&
+      if (missed_face_passes < kMissedFacePasses && contacts_ != nullptr &&
           surface_holds_.findMissedFaces(model, start_x_, state.velocity, h, *contacts_))
-        ++planned;
-      if (k + 1 < planned)
       {
-        if (contacts_ != nullptr)
-          collider_holds_.letGoPulling(h, delta_v_);
-        surface_holds_.letGoPulling(h, delta_v_);
+        ++missed_face_passes;
+        assembleAtIterate(model, state, h);
+        continue;
       }
+      // Converged at the iterate: the holds' forces are the ones assembled there, no solve's change on top.
+      delta_v_.setZero();
+      break;
     }
     if (contacts_ != nullptr)
       collider_holds_.noteForces(model, h, delta_v_, *contacts_);
@@ -214,6 +221,38 @@ private:
     if (!surface_holds_.empty() && !system_.iterativeOnly())
       surface_holds_.placePairs(system_);
     system_.solve(Blocks{ model, kinds_, surface_holds_ }, surface_holds_.empty(), delta_v_);
+  }
+
+  /// The system at the iterate v_k: linearised at x_lin = x_n + h v_k (the offset 0), its rhs the residual.
+  void assembleAtIterate(const Model& model, const State& state, double h)
+  {
+    offset_.setZero();
+    linear_x_ = start_x_;
+    for (int i = 0; i < model.nodeCount(); ++i)
+      if (model.isFree(i))
+        linear_x_.col(i) += h * state.velocity.col(i);
+    assemble(NewtonPoint{ model, linear_x_, state.velocity, state.twist, offset_, h }, false);
+  }
+
+  /// NewtonRule's test on the assembled residual r (rhs): sqrt(sum |r_i|^2 / m_i / sum m_i) at most
+  /// NewtonRule::allowedResidualSpeed, over the free nodes.
+  bool converged(const Model& model, const NodeArray& v, double h) const
+  {
+    const NodeArray& r = system_.rhs();
+    double weighted_residual = 0.0, mass = 0.0, largest_change = 0.0, fastest = 0.0;
+    for (int i = 0; i < model.nodeCount(); ++i)
+    {
+      if (!model.isFree(i))
+        continue;
+      weighted_residual += r.col(i).squaredNorm() * model.inverse_mass[i];
+      mass += model.mass[i];
+      largest_change = std::max(largest_change, (v.col(i) - start_v_.col(i)).norm());
+      fastest = std::max(fastest, v.col(i).norm());
+    }
+    if (!(mass > 0.0))
+      return true;  // nothing free: nothing to solve for
+    return std::sqrt(weighted_residual / mass) <=
+           NewtonRule::allowedResidualSpeed(model.gravity.norm() * h, largest_change, fastest);
   }
 
   /// The most Newton iterations a step adds for face contacts its solve alone ran into.
