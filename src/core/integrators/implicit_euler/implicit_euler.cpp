@@ -108,7 +108,7 @@ public:
       return;
     }
     const int most = std::max(iterations, NewtonRule::kMostIterations);
-    int solves = 0, missed_face_passes = 0;
+    int solves = 0;
     // x_lin = x_n and the offset h v_n at which K acts on the first iteration (Baraff and Witkin's step).
     offset_.setZero(3, n);
     for (int i = 0; i < n; ++i)
@@ -122,23 +122,13 @@ public:
         if (model.isFree(i))
           state.velocity.col(i) += delta_v_.col(i);
       ++solves;
-      if (solves >= most + missed_face_passes)
+      if (solves >= most)
         break;
       if (contacts_ != nullptr)
         collider_holds_.letGoPulling(h, delta_v_);
-      surface_holds_.letGoPulling(h, delta_v_);
       assembleAtIterate(model, state, h);
       if (solves < iterations || !converged(model, state.velocity, h))
         continue;
-      // One more iteration where the velocities carry a triangle into a collider that no hold holds off
-      // (findMissedFaces), at most kMissedFacePasses more.
-      if (missed_face_passes < kMissedFacePasses && contacts_ != nullptr &&
-          surface_holds_.findMissedFaces(model, start_x_, state.velocity, h, *contacts_))
-      {
-        ++missed_face_passes;
-        assembleAtIterate(model, state, h);
-        continue;
-      }
       // Converged at the iterate: the holds' forces are the ones assembled there, no solve's change on top.
       delta_v_.setZero();
       break;
