@@ -270,7 +270,7 @@ struct StepSettings
 {
   double dt = 0.001;   ///< [s] fixed physics step, > 0
   int substeps = 1;    ///< sub-steps per step, >= 1
-  int iterations = 1;  ///< constraint/relaxation iterations (implicit_euler: the fewest Newton iterations), >= 1
+  int iterations = 1;  ///< constraint/relaxation iterations (implicit_euler: Newton iterations), >= 1
 
   void carry(StateArchive& archive) { archive(dt, substeps, iterations); }
 };

@@ -98,7 +98,7 @@ public:
   /// scratch a step makes anew.
   virtual void carry(StateArchive& archive, const Model& model) = 0;
   /// Advances `state` by h [s]. Pinned nodes (inverse mass 0) are never moved: their position and
-  /// velocity belong to the caller. `iterations`: constraint/relaxation passes (implicit_euler: fewest Newton).
+  /// velocity belong to the caller. `iterations` is the constraint/relaxation/Newton count.
   virtual void step(const Model& model, State& state, double h, int iterations) = 0;
   /// step(), where the scene has colliders (`contacts`; null: none). A solve that can take contacts into
   /// it does (xpbd's chains: chain_contacts.h; implicit Euler's solids: collider_holds.h) and hands the
