@@ -74,6 +74,7 @@ public:
   Matrix3& diagonal(int node) { return diagonal_[static_cast<std::size_t>(node)]; }
   /// The right-hand side (3 x nodes).
   NodeArray& rhs() { return rhs_; }
+  const NodeArray& rhs() const { return rhs_; }
   /// Sizes the right-hand side and the diagonal for `nodes` nodes and restarts the condition estimate.
   void start(int nodes)
   {
