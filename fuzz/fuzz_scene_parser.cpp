@@ -14,6 +14,7 @@
 #include <string>
 
 #include "soft_body_sim/scene/scene_loader.h"
+#include "core/integrators/integrator_kit.h"
 
 namespace
 {
@@ -52,12 +53,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // (2.0 s for soft_box.yaml's 937, 4.3 s for soft_stack.yaml's 1,560, 40 s for a 12,600-tetrahedron bar
   // the fuzzer made, beyond its 25 s timeout): the largest solid that steps (2,000) stays near 6 s. A
   // solid's surface sample counts one (a distance to each collider near it per sub-step).
+  // With soft solids, implicit_euler takes up to NewtonRule's most iterations, whatever `iterations` says.
   std::size_t elements = 0;
+  bool solids = false;
   for (const BodyDef& body : scene.bodies)
+  {
     elements += body.nodes.size() + body.springs.size() + body.constraints.size() + body.cells.size() +
                 5 * body.tetrahedra.size() + body.surface_samples.size();
-  const double work =
-      static_cast<double>(elements) * scene.physics.step.substeps * scene.physics.step.iterations;
+    solids = solids || !body.tetrahedra.empty();
+  }
+  const int iterations = solids ? std::max(scene.physics.step.iterations, NewtonRule::kMostIterations)
+                                : scene.physics.step.iterations;
+  const double work = static_cast<double>(elements) * scene.physics.step.substeps * iterations;
   if (work > 1e4)
     return 0;
   try
