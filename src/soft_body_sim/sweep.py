@@ -95,7 +95,7 @@ def specs_of(sweep, runs):
 
 class Tasks:
     """The runs of `specs` as Dask tasks on `client`, sized as TASK_SECONDS says; iterated, each task as it
-    finishes (in any order): its future and its runs."""
+    finishes (in any order): its future, its runs and their results (None if the task failed), fetched once."""
 
     def __init__(self, client, specs):
         self.client = client
@@ -126,12 +126,12 @@ class Tasks:
     def __iter__(self):
         for future in self.finished:
             runs = self.runs_of.pop(future.key)
+            results = None if future.status == "error" else future.result()
             if self.runs_per_task is None:
-                stepped = [] if future.status == "error" else \
-                    [result["cpu_seconds"] for result in future.result() if "time" in result]
+                stepped = [result["cpu_seconds"] for result in results or [] if "time" in result]
                 if stepped or self.finished.is_empty():
                     self.size_the_rest(max(stepped) if stepped else None)
-            yield future, runs
+            yield future, runs, results
 
 
 def run_sweep(sweep, out, scheduler=None, workers=None, stream=None, client=None):
@@ -156,13 +156,13 @@ def run_sweep(sweep, out, scheduler=None, workers=None, stream=None, client=None
             lost = []
             # Written here as each task finishes, and flushed, never by the workers: a task Dask retried or ran
             # on two workers arrives once per future, and store.add keeps the first.
-            for future, runs in Tasks(client, specs):
-                if future.status == "error":
+            for future, runs, results in Tasks(client, specs):
+                if results is None:
                     lost += [f"{run.id}: {future.exception()}" for run in runs]
                     for _ in runs:
                         progress.update(failed=True)
                 else:
-                    for result in future.result():
+                    for result in results:
                         store.add(result)
                         progress.update(failed=result["status"] != "ok")
                     store.flush()

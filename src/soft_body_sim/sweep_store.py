@@ -70,7 +70,7 @@ class Store:
         if "time" in result:
             for name, unit in (("time", "s"), ("positions", "m"), ("tensions", "N"),
                                ("wrenches", "N (force x, y, z), N m (torque x, y, z, about the anchor's node)")):
-                group.create_dataset(name, data=result[name]).attrs["unit"] = unit
+                write_attrs(group.create_dataset(name, data=result[name]), {"unit": unit})
             for name in ("node_names", "tension_bodies", "anchor_names"):
                 group[name] = self.shared_names(result[name])
         self.csv.writerow(self.row(result["id"], result["values"], result))  # from memory: h5 reads cost ms

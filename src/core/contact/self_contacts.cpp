@@ -42,6 +42,13 @@ double leastDistance(const NodeArray& x, const std::pair<int, int>& from, const 
   return ((xa + p * along_from) - (xc + q * along_to)).norm();
 }
 
+/// Whether a lower bound of two links' distance, `bound` [m], puts them beyond `reach` [m]: with a hair's
+/// margin, so that the rounding of the bound (sums of distances and motions) stays on the side of looking.
+bool beyond(double bound, double reach)
+{
+  return bound > reach * (1.0 + 1e-9) + 1e-12;
+}
+
 /// Coulomb friction at a contact of unit normal n: the change of `relative` (a motion, or a velocity, at
 /// the contact) that cancels its tangential part up to friction * budget, what it takes spent from budget;
 /// none if it has no tangential part.
@@ -469,14 +476,14 @@ bool SelfContacts::resolve(const Model& model, State& state)
     // Their points have moved, relative to the mean motion (which changes no distance), no farther than
     // their farthest node: a pair whose least distance was more than that beyond the contact distance is
     // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
-    // sub-step until the list is found again). A hair's margin keeps the rounding of the bound on the safe
-    // side.
-    if (candidate.distance - moved(segments_[s]) - moved(segments_[t]) > touching * (1.0 + 1e-9) + 1e-12)
+    // sub-step until the list is found again).
+    const double bound = candidate.distance - moved(segments_[s]) - moved(segments_[t]);
+    if (beyond(bound, touching))
       continue;
     // Near if their contact at this call's start is within their near radii; whether it is, is found only
-    // once the passes could have brought them into touch (nearPair), from the positions then (entry_).
+    // once the passes could have brought them into touch (near_pair), from the positions then (entry_).
     near_index_[i] = kUnknown;
-    candidate_bound_[i] = candidate.distance - moved(segments_[s]) - moved(segments_[t]);
+    candidate_bound_[i] = bound;
   }
   // Candidate i's near pair, or none: whether it is near is found the first time it is asked while its links
   // may touch (their least distance at the start, bounded below by candidate_bound_, less what the passes
@@ -489,7 +496,7 @@ bool SelfContacts::resolve(const Model& model, State& state)
     if (near_index_[i] == kUnknown)
     {
       const std::uint32_t s = candidates_[i].s, t = candidates_[i].t;
-      if (candidate_bound_[i] - travelled(s, t) > (radius_[s] + radius_[t]) * (1.0 + 1e-9) + 1e-12)
+      if (beyond(candidate_bound_[i] - travelled(s, t), radius_[s] + radius_[t]))
         return nullptr;
       NearPair pair{ s, t, 0.0, 0.0 };
       pair.valid = contact_at(entry_, s, t, pair.contact);
@@ -561,11 +568,10 @@ bool SelfContacts::resolve(const Model& model, State& state)
   // farther than its farthest node, so their least distance (which the contact's never undercuts) has shrunk
   // by at most what the four moved. Its pass would push by nothing and stop nothing, so it is passed over,
   // its nearest points not looked for (most near pairs of a pile: 270 of the 313 of the demo's coil, each
-  // looked for again in every pass once a neighbour moved); the same bits. The hair's margin as above.
+  // looked for again in every pass once a neighbour moved); the same bits.
   const auto stays_apart = [&](const NearPair& pair) {
     return pair.push == 0.0 && pair.stop == 0.0 && pair.valid &&
-           pair.contact.least - (travelled(pair.s, pair.t) - pair.travel) >
-               (radius_[pair.s] + radius_[pair.t]) * (1.0 + 1e-9) + 1e-12;
+           beyond(pair.contact.least - (travelled(pair.s, pair.t) - pair.travel), radius_[pair.s] + radius_[pair.t]);
   };
   for (int pass = 0; pass < kPasses; ++pass)
     for (std::size_t i = 0; i < candidates_.size(); ++i)

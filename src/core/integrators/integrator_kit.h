@@ -175,10 +175,9 @@ std::unique_ptr<Integrator> makeImplicitEuler(LinearSolve solve);
 /// least StepSettings::iterations of them, once the step's equations hold to kTolerance, or after
 /// kMostIterations (or `iterations`, if more); without solids, or where other bodies can meet a solid's
 /// surface, after `iterations`. The test is on the residual r = h f(x_n + h v, v) - M (v - v_n) of the
-/// iterate v: the Newton system's
-/// matrix A is at least M (each kind keeps its blocks positive semi-definite), so v's error v - v* = A^-1 r
-/// has |v - v*|_M <= |r|_M^-1, and the step stops once that bound, as a mass-weighted RMS speed
-/// sqrt(sum |r_i|^2 / m_i / sum m_i), is at most allowedResidualSpeed.
+/// iterate v: the Newton system's matrix A is at least M (each kind keeps its blocks positive
+/// semi-definite), so v's error v - v* = A^-1 r has |v - v*|_M <= |r|_M^-1, and the step stops once that
+/// bound, as a mass-weighted RMS speed sqrt(sum |r_i|^2 / m_i / sum m_i), is at most allowedResidualSpeed.
 struct NewtonRule
 {
   /// The velocity error a step keeps, relative to its speed scale |g| h + max |v_i - v_n,i| (what gravity

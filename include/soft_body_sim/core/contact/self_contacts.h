@@ -142,10 +142,11 @@ public:
   std::size_t searches() const { return searches_; }
 
   /// Writes or reads the Verlet lists and what the passes keep from sub-step to sub-step
-  /// (state_archive.h); the links, faces and their radii are the scene's.
+  /// (state_archive.h); the links, faces and their radii are the scene's, and travel_, entry_, near_index_
+  /// and candidate_bound_ are each resolve's own, written before it reads them.
   void carry(StateArchive& archive)
   {
-    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, travel_, entry_, near_index_, candidate_bound_, tick_,
+    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, tick_,
             face_centre_, face_extent_, face_grid_, face_candidates_, near_faces_);
   }
 
