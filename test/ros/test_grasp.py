@@ -61,8 +61,10 @@ class GraspTest(NodeTestCase):
             subscriber.unregister()
         message = wrenches[-1]
         self.assertEqual(message.header.frame_id, "world")
-        # Stamped with the simulated instant, as the state of the same tick.
-        self.assertIn(message.header.stamp, [s.header.stamp for s in self.state.states])
+        # Stamped with the simulated instant, as the state of the same tick. The two topics have their own
+        # connections, so that state may arrive after the wrench: wait for it.
+        self.assertTrue(wait_for(lambda: message.header.stamp in (s.header.stamp for s in self.state.states), 5.0),
+                        f"no state stamped {message.header.stamp.to_sec()} s, as the wrench is")
         force, torque = message.wrench.force, message.wrench.torque
         self.assertAlmostEqual(force.z, -weight, delta=1e-3 * weight)
         self.assertAlmostEqual(math.hypot(force.x, force.y), 0.0, delta=1e-3 * weight)
