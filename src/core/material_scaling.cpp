@@ -1,5 +1,6 @@
 #include "soft_body_sim/core/material_scaling.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -7,15 +8,52 @@
 
 namespace soft_body_sim
 {
+namespace
+{
+bool unit(const BodyScaling& scaling)
+{
+  return scaling.stiffness == 1.0 && scaling.damping == 1.0 && scaling.pressure == 1.0;
+}
+}  // namespace
+
 MaterialScaling::MaterialScaling(const Model& built) : scaling_(built.bodies.size()), has_material_(built.bodies.size(), 0)
 {
   auto elements = std::make_shared<Model>();
   forEachKind([&](auto kind) {
-    kind.of(*elements) = kind.of(built);
+    if (kind.kChangesAsHeld)
+      kind.of(*elements) = kind.of(built);
     for (const auto& element : kind.of(built))
       has_material_[built.bodyOf(kind.bodyNode(element))] = 1;
   });
   built_ = std::move(elements);
+}
+
+void MaterialScaling::keepBuilt(const Model& model)
+{
+  if (all_kept_)
+    return;
+  auto elements = std::make_shared<Model>();
+  forEachKind([&](auto kind) { kind.of(*elements) = kind.kChangesAsHeld ? kind.of(*built_) : kind.of(model); });
+  built_ = std::move(elements);
+  all_kept_ = true;
+}
+
+void MaterialScaling::dropBuiltIfUnscaled()
+{
+  if (!all_kept_ || !std::all_of(scaling_.begin(), scaling_.end(), unit))
+    return;
+  auto elements = std::make_shared<Model>();
+  forEachKind([&](auto kind) {
+    if (kind.kChangesAsHeld)
+      kind.of(*elements) = kind.of(*built_);
+  });
+  built_ = std::move(elements);
+  all_kept_ = false;
+}
+
+void MaterialScaling::builtElements(const Model& model, Model& into) const
+{
+  forEachKind([&](auto kind) { kind.of(into) = kind.kChangesAsHeld || all_kept_ ? kind.of(*built_) : kind.of(model); });
 }
 
 void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& scaling)
@@ -25,6 +63,12 @@ void MaterialScaling::set(Model& model, std::size_t body, const BodyScaling& sca
       !(scaling.pressure > 0.0 && std::isfinite(scaling.pressure)) ||
       !(scaling.damping >= 0.0 && std::isfinite(scaling.damping)))
     throw std::invalid_argument("World: body scaling: stiffness and pressure must be finite and > 0, damping >= 0");
+  if (!all_kept_ && unit(scaling))
+  {
+    scaling_.at(body) = scaling;  // every factor 1 before and after: the model is as built
+    return;
+  }
+  keepBuilt(model);
   scaling_.at(body) = scaling;
   // From the built values, not the current ones: factors do not compound and 1 restores the scene.
   forEachKind([&](auto kind) {

@@ -33,6 +33,7 @@ Look lookOf(const BodyDef& body, std::size_t index, int first, const std::vector
   look.radius = body.contact_radius > 0.0 ? body.contact_radius : kDefaultLookRadius;
   look.color = body.color.value_or(defaultBodyColor(index));
   const auto global = [&](int local) { return globalIndex(body, first, local); };
+  look.faces.reserve(body.faces.size());  // a 100,000-node cloth's faces grown by doubling held 8 bytes a node more
   for (const std::array<int, 3>& face : body.faces)
     look.faces.push_back({ global(face[0]), global(face[1]), global(face[2]) });
   if (look.faces.empty())

@@ -127,16 +127,11 @@ std::uint64_t World::fingerprint() const
 {
   // A world's own copy of what it was built with, so that nothing it changes as it runs counts.
   Model fixed;
-  const Model& built = material_.built();
   fixed.mass = model_.mass;
   fixed.contact_radius = model_.contact_radius;
   fixed.contact_segments = model_.contact_segments;
   fixed.contact_triangles = model_.contact_triangles;
-  fixed.springs = built.springs;
-  fixed.constraints = built.constraints;
-  fixed.cells = built.cells;
-  fixed.rods = built.rods;
-  fixed.tetrahedra = built.tetrahedra;
+  material_.builtElements(model_, fixed);
   fixed.surface_samples = model_.surface_samples;
   fixed.bodies = model_.bodies;
   fixed.colliders = model_.colliders;
@@ -160,11 +155,14 @@ void World::restore(const WorldSnapshot& snapshot)
     throw anotherScene(snapshot.summary_, sceneSummary(model_));
   // Read into a copy, so that bytes that fail part way leave this world as it was.
   World next(*this);
+  // The bytes' elements carry their world's factors: the values they multiply must be kept first.
+  next.material_.keepBuilt(next.model_);
   StateArchive reader(snapshot.bytes_->data() + snapshot.body_, snapshot.bytes_->size() - snapshot.body_);
   next.carry(reader);
   if (reader.left() != 0)
     throw std::invalid_argument("snapshot bytes: " + std::to_string(reader.left()) +
                                 " more than this scene's values");
+  next.material_.dropBuiltIfUnscaled();
   next.integration_observer_ = std::move(integration_observer_);
   *this = std::move(next);
 }

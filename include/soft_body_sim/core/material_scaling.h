@@ -21,28 +21,38 @@ struct BodyScaling
   void carry(StateArchive& archive) { archive(stiffness, damping, pressure); }
 };
 
+/// The values the factors multiply are the elements as built. While every factor is 1 the model's own
+/// elements are those values, so no copy of them is kept (a cloth's springs are 190 bytes a node): the
+/// copy is made when a factor other than 1 is first set, or before a snapshot's bytes are read into the
+/// model. Only the kinds whose elements change as a body is held (a rod's stations) are kept from the start.
 class MaterialScaling
 {
 public:
-  /// Keeps `built`'s elements (every kind's) as the values the factors multiply.
+  /// For a model as built: keeps what holding changes of it (see the class comment).
   explicit MaterialScaling(const Model& built);
 
   /// Writes body `body`'s elements into `model` as built times `scaling` (each kind's scale). Throws
   /// std::invalid_argument if a factor is out of range (see BodyScaling) and changes nothing then.
   void set(Model& model, std::size_t body, const BodyScaling& scaling);
+  /// Keeps a copy of `model`'s elements as built if none is kept yet (every factor is 1, so they are).
+  void keepBuilt(const Model& model);
+  /// Drops that copy again if every factor is 1 (the model's elements are as built then).
+  void dropBuiltIfUnscaled();
   /// The scaling last set for body `body` (all 1 if never set).
   const BodyScaling& of(std::size_t body) const { return scaling_.at(body); }
   /// True if body `body` was built with elements of any kind: a material to scale.
   bool has(std::size_t body) const { return has_material_.at(body) != 0; }
-  /// The element arrays as built (the rest of this model is empty).
-  const Model& built() const { return *built_; }
+  /// Writes every kind's elements as built into `into`'s element arrays (`model` is the live model).
+  void builtElements(const Model& model, Model& into) const;
 
   /// Writes or reads the factors (state_archive.h); what they multiply is the scene's.
   void carry(StateArchive& archive) { archive(scaling_); }
 
 private:
-  /// The elements as built (its element arrays only); never changed, so copies of a world share it.
+  /// The elements as built (its element arrays only: the kinds that change as held, and all of them while
+  /// all_kept_); never changed, so copies of a world share it.
   std::shared_ptr<const Model> built_;
+  bool all_kept_ = false;
   std::vector<BodyScaling> scaling_;  ///< per body
   std::vector<char> has_material_;    ///< per body
 };

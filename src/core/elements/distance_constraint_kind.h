@@ -23,6 +23,7 @@ struct DistanceConstraintKind
     return mine(c.a) || mine(c.b);
   }
   static bool runsUnder(IntegratorType) { return true; }
+  static constexpr bool kChangesAsHeld = false;
   /// C^2 / (2 alpha) (Macklin et al. 2016: the compliant constraint's potential); an inextensible one
   /// (alpha = 0) holds C = 0 and stores nothing.
   static double energy(const DistanceConstraint& c, const State& state)

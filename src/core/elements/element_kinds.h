@@ -11,6 +11,7 @@
 //   bodyNode(e)                                     a node of e, which tells its body (an element lies in one body)
 //   touches(e, mine)                                whether e acts on a node for which mine(node) holds
 //   runsUnder(IntegratorType)                       whether that integrator steps this kind
+//   kChangesAsHeld                                  whether holding a body changes its elements (a rod's stations)
 //   energy(e, state)                                its stored energy [J] (elastic, or its gas's)
 //   scale(e, built, scaling)                        e as built times a body's live factors (BodyScaling)
 //   addPulls(model, state, forces, pull)            its forces on the nodes [N] (reactions.h), all elements

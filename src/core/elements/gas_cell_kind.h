@@ -26,6 +26,7 @@ struct GasCellKind
     return std::any_of(std::begin(cell.nodes), std::end(cell.nodes), mine);
   }
   static bool runsUnder(IntegratorType) { return true; }
+  static constexpr bool kChangesAsHeld = false;
   static double energy(const PressureCell& cell, const State& state)
   {
     return cellGas(cell, cellArea(cell, state.position)).energy;

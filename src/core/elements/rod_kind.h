@@ -25,6 +25,8 @@ struct RodKind
     return mine(rod.first);
   }
   static bool runsUnder(IntegratorType integrator) { return integrator == IntegratorType::ImplicitEuler; }
+  /// Its stations (clamps, holds) come and go as it is held: what it was built with is kept from the start.
+  static constexpr bool kChangesAsHeld = true;
   static double energy(const Rod& rod, const State& state) { return rodEnergy(rod, state.position, state.twist); }
   /// E I and G J scale with the stretching's E (and G), beta with the dashpots.
   static void scale(Rod& rod, const Rod& built, const BodyScaling& scaling)

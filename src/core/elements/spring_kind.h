@@ -23,6 +23,7 @@ struct SpringKind
     return mine(s.a) || mine(s.b);
   }
   static bool runsUnder(IntegratorType) { return true; }
+  static constexpr bool kChangesAsHeld = false;
   /// k (|d| - L)^2 / 2.
   static double energy(const Spring& s, const State& state)
   {

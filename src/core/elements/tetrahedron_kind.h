@@ -25,6 +25,7 @@ struct TetrahedronKind
     return std::any_of(std::begin(tet.nodes), std::end(tet.nodes), mine);
   }
   static bool runsUnder(IntegratorType integrator) { return integrator == IntegratorType::ImplicitEuler; }
+  static constexpr bool kChangesAsHeld = false;
   static double energy(const Tetrahedron& tet, const State& state) { return tetEnergy(tet, state.position); }
   /// mu and lambda scale with E (Poisson's ratio kept), the gas's p0 as a jelly cell's.
   static void scale(Tetrahedron& tet, const Tetrahedron& built, const BodyScaling& scaling)

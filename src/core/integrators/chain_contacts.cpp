@@ -39,15 +39,17 @@ void ChainContacts::setPaths(const Model& model, std::vector<ChainPath> paths)
         listed[static_cast<std::size_t>(node)] = 1;
         nodes_.push_back(node);
       }
-  const Eigen::Index count = nodes;
-  holds_.kind.assign(static_cast<std::size_t>(nodes), NodeHolds::kFree);
+  // The arrays are per node of the model, for the solve's node indices; a scene without chains (a cloth)
+  // holds none of them (about 250 bytes a node).
+  const Eigen::Index count = paths_.empty() ? 0 : nodes;
+  holds_.kind.assign(static_cast<std::size_t>(count), NodeHolds::kFree);
   holds_.normal.setZero(3, count);
   holds_.push.setZero(3, count);
   holds_.slip.setZero(3, count);
-  holds_.friction.assign(static_cast<std::size_t>(nodes), 0.0);
-  before_.assign(static_cast<std::size_t>(nodes), NodeHolds::kFree);
+  holds_.friction.assign(static_cast<std::size_t>(count), 0.0);
+  before_.assign(static_cast<std::size_t>(count), NodeHolds::kFree);
   predicted_.setZero(3, count);
-  contact_.assign(static_cast<std::size_t>(nodes), NodeContact{ Vec3::UnitZ(), Vec3::Zero(), 0.0, 0.0 });
+  contact_.assign(static_cast<std::size_t>(count), NodeContact{ Vec3::UnitZ(), Vec3::Zero(), 0.0, 0.0 });
   slip_.setZero(3, count);
   impulse_.setZero(3, count);
   pressed_.clear();
