@@ -324,6 +324,32 @@ TEST(Determinism, BytesOfAnotherMaterialScalingStepOnWithTheirSprings)
   EXPECT_EQ(hashOf(plain), hashOf(stiffened));
 }
 
+TEST(Determinism, AWorldRestoredFromAScaledOnesBytesKeepsTheScenesMaterial)
+{
+  // A world keeps no copy of its springs as built while its factors are 1 (MaterialScaling): restored from
+  // the bytes of a world whose springs were stiffened, it takes that world's springs and factor, and a
+  // factor of 1 then gives back the scene's springs, whose fingerprint every world of the scene shares.
+  const SceneDef scene = loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/rope.yaml");
+  const std::string body = scene.bodies.front().name;
+  const World fresh = buildWorld(scene);
+  World stiffened = buildWorld(scene);
+  BodyScaling twice;
+  twice.stiffness = 2.0;
+  ASSERT_TRUE(stiffened.setBodyScaling(body, twice));
+  EXPECT_EQ(stiffened.fingerprint(), fresh.fingerprint());
+  World plain = buildWorld(scene);
+  plain.restore(WorldSnapshot::fromBytes(stiffened.snapshot().toBytes()));
+  EXPECT_EQ(plain.bodyScaling(body).stiffness, 2.0);
+  EXPECT_EQ(plain.fingerprint(), fresh.fingerprint());
+  ASSERT_EQ(plain.model().springs.size(), fresh.model().springs.size());
+  for (std::size_t k = 0; k < fresh.model().springs.size(); ++k)
+    EXPECT_EQ(plain.model().springs[k].stiffness, 2.0 * fresh.model().springs[k].stiffness) << k;
+  ASSERT_TRUE(plain.setBodyScaling(body, BodyScaling{}));
+  for (std::size_t k = 0; k < fresh.model().springs.size(); ++k)
+    EXPECT_EQ(plain.model().springs[k].stiffness, fresh.model().springs[k].stiffness) << k;
+  EXPECT_EQ(plain.fingerprint(), fresh.fingerprint());
+}
+
 TEST(Determinism, ASnapshotOfAnotherSceneIsRefusedNamingBoth)
 {
   World rope = buildWorld(loadSceneFile(std::string(SOURCE_DIR) + "/config/scenes/rope.yaml"));
