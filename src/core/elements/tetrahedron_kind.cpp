@@ -1,9 +1,17 @@
 #include "core/elements/tetrahedron_kind.h"
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 namespace soft_body_sim
 {
 void TetrahedronKind::ImplicitBlocks::analyze(const Model& model, BlockSystem& system)
 {
+  std::vector<std::size_t> per_body(model.bodies.size(), 0);
+  for (const Tetrahedron& tet : model.tetrahedra)
+    ++per_body[model.bodyOf(tet.nodes[0])];
+  largest_solid_ = per_body.empty() ? 0 : *std::max_element(per_body.begin(), per_body.end());
   slot_.assign(6 * model.tetrahedra.size(), -1);
   for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
     for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
@@ -14,8 +22,8 @@ void TetrahedronKind::ImplicitBlocks::analyze(const Model& model, BlockSystem& s
     }
 }
 
-/// The blocks (the diagonal ones into the system's diagonal) and h (f + K offset) in rhs (K = -df/dx). The
-/// condition estimate takes each node's block of one tetrahedron as a spring's.
+/// The blocks (the diagonal ones into the system's diagonal) and h (f + K offset) in rhs (K = -df/dx), and
+/// the estimate of CG's sweeps on the largest solid (kSweepsPerCubeRoot).
 void TetrahedronKind::ImplicitBlocks::assemble(const NewtonPoint& point, BlockSystem& system)
 {
   const Model& model = point.model;
@@ -50,11 +58,9 @@ void TetrahedronKind::ImplicitBlocks::assemble(const NewtonPoint& point, BlockSy
       k_ab *= h * h;
     for (int a = 0; a < 4; ++a)
       if (block.nodes[a] >= 0)
-      {
         system.diagonal(block.nodes[a]) += block.scaled.blocks[a];
-        system.noteCondition(1.0 + 4.0 * block.scaled.blocks[a].trace() * model.inverse_mass[tet.nodes[a]]);
-      }
   }
+  system.noteSolidSweeps(kSweepsPerCubeRoot * std::cbrt(static_cast<double>(largest_solid_)));
 }
 
 void TetrahedronKind::ImplicitBlocks::multiply(const Model&, const NodeArray& p, NodeArray& out) const

@@ -81,10 +81,14 @@ public:
     rhs_.resize(3, nodes);
     diagonal_.resize(static_cast<std::size_t>(nodes));
     condition_ = 1.0;
+    solid_sweeps_ = 0.0;
   }
   /// An element's estimate of the block-Jacobi preconditioned A's condition number (the largest is kept):
   /// about 1 + 4 (h^2 k + h c) / m for a spring of stiffness k and dashpot c on its lightest free end m.
   void noteCondition(double condition) { condition_ = std::max(condition_, condition); }
+  /// A soft solid's estimate of the sweeps conjugate gradients take on it (the largest is kept): its
+  /// sweeps grow with the mesh's size, not with its elements' stiffness over mass (TetrahedronKind).
+  void noteSolidSweeps(double sweeps) { solid_sweeps_ = std::max(solid_sweeps_, sweeps); }
 
   /// dv = A^-1 rhs: directly, A written from the diagonal and `blocks` into the analysed pattern (block
   /// tridiagonal where the free nodes form chains and `chains_usable`, else sparse), or by conjugate
@@ -98,9 +102,10 @@ public:
       solveDirectly(blocks, tridiagonal_solver_, dv);
       return;
     }
-    const bool cheaper_by_cg = mode_ == LinearSolve::Cheaper &&
-                               sparse_solver_.factorWork() / sparse_solver_.matrixEntries() >
-                                   kDirectWorkPerRootCondition * std::sqrt(condition_);
+    const double cg_cost = std::max(kDirectWorkPerRootCondition * std::sqrt(condition_),
+                                    kDirectWorkPerSolidSweep * solid_sweeps_);
+    const bool cheaper_by_cg =
+        mode_ == LinearSolve::Cheaper && sparse_solver_.factorWork() / sparse_solver_.matrixEntries() > cg_cost;
     if (!factorable_ || cheaper_by_cg)
     {
       buildPreconditioner(blocks);
@@ -209,6 +214,13 @@ private:
   /// 1 g nodes, dt = 1/60 s: ~1e6): always direct, and linear in the length. At small steps the mass
   /// dominates the matrix (condition ~1) and CG serves every cloth.
   static constexpr double kDirectWorkPerRootCondition = 4.0;
+  /// On soft solids the condition estimate says little: CG's sweeps there hardly change with the step (at
+  /// 1/60 and 4 ms: 167 and 146 on the benchmark box of 1,243 tetrahedra, where sqrt(condition) is 300 and
+  /// 72) and grow with the mesh (TetrahedronKind's estimate). Measured (bench_step BM_SoftBox direct and
+  /// iterative, both steps, docs/RESULTS.md "Soft solids"): direct is faster at 3,127 tetrahedra (136
+  /// multiply-adds per entry; CG took 239 sweeps at 1/60 s) and CG at 5,269 (266; 268 sweeps): the direct
+  /// path while its work per entry <= 0.7 of the estimated sweeps.
+  static constexpr double kDirectWorkPerSolidSweep = 0.7;
   /// No factorisation is even prepared beyond this work per entry (a 100,000-node cloth would need
   /// 0.75 GB for its factor).
   static constexpr double kMaxFactorWork = 2000.0;
@@ -220,6 +232,7 @@ private:
   bool chains_ = false;                     ///< the pairs form chains: tridiagonal_solver_ can solve
   bool factorable_ = true;                  ///< the pattern is prepared for a direct solve (see kMaxFactorWork)
   double condition_ = 1.0;                  ///< estimate of block-Jacobi preconditioned A's condition number
+  double solid_sweeps_ = 0.0;               ///< the soft solids' estimate of CG's sweeps (0: none)
   NodeArray rhs_;
   std::vector<Matrix3> diagonal_;        ///< per node: its block of A (but the kinds' kept apart)
   std::vector<Matrix3> preconditioner_;  ///< per node: the inverse of A's full diagonal block (CG)
