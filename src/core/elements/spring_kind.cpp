@@ -7,6 +7,7 @@ namespace soft_body_sim
 void SpringKind::ImplicitBlocks::analyze(const Model& model, BlockSystem& system)
 {
   slot_.assign(model.springs.size(), -1);
+  system.reservePairs(model.springs.size());
   for (std::size_t k = 0; k < model.springs.size(); ++k)
   {
     const Spring& s = model.springs[k];

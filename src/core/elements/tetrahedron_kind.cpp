@@ -13,6 +13,7 @@ void TetrahedronKind::ImplicitBlocks::analyze(const Model& model, BlockSystem& s
     ++per_body[model.bodyOf(tet.nodes[0])];
   largest_solid_ = per_body.empty() ? 0 : *std::max_element(per_body.begin(), per_body.end());
   slot_.assign(6 * model.tetrahedra.size(), -1);
+  system.reservePairs(6 * model.tetrahedra.size());
   for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
     for (std::size_t p = 0; p < kFourNodePairs.size(); ++p)
     {

@@ -44,6 +44,9 @@ public:
     return static_cast<int>(pairs_.size()) - 1;
   }
   std::size_t pairCount() const { return pairs_.size(); }
+  /// Room for `more` pairs beyond those there (a kind adds its pairs after it: no spare capacity from
+  /// growth by doubling, 36 bytes a node on a large cloth).
+  void reservePairs(std::size_t more) { pairs_.reserve(pairs_.size() + more); }
   const std::vector<std::pair<int, int>>& pairs() const { return pairs_; }
   /// Drops the pairs after the first `count` (those a kind added later and no longer needs).
   void truncatePairs(std::size_t count) { pairs_.resize(count); }

@@ -10,14 +10,17 @@ void ColliderHolds::analyze(const Model& model)
 {
   held_node_.assign(static_cast<std::size_t>(model.nodeCount()), 0);
   hold_force_.assign(static_cast<std::size_t>(model.nodeCount()), 0.0);
-  holds_.clear();
-  holds_.reserve(static_cast<std::size_t>(model.nodeCount()));
   for (const Tetrahedron& tet : model.tetrahedra)
     for (const int node : tet.nodes)
       held_node_[static_cast<std::size_t>(node)] = 1;
   for (const std::array<int, 3>& triangle : model.contact_triangles)
     for (const int node : triangle)
       held_node_[static_cast<std::size_t>(node)] = 1;
+  // Room for a hold on every node that can be held (no allocation in a step), not on every node: a cloth
+  // without face contacts has none (a hold is 160 bytes).
+  holds_.clear();
+  holds_.shrink_to_fit();
+  holds_.reserve(static_cast<std::size_t>(std::count(held_node_.begin(), held_node_.end(), 1)));
 }
 
 void ColliderHolds::assemble(const NewtonPoint& point, const ContactQuery& contacts, bool first_iteration,
