@@ -14,18 +14,26 @@ bool unit(const BodyScaling& scaling)
 {
   return scaling.stiffness == 1.0 && scaling.damping == 1.0 && scaling.pressure == 1.0;
 }
-}  // namespace
 
-MaterialScaling::MaterialScaling(const Model& built) : scaling_(built.bodies.size()), has_material_(built.bodies.size(), 0)
+/// The element arrays of `built` of the kinds kept from the start (kChangesAsHeld), the others empty.
+std::shared_ptr<const Model> changingAsHeld(const Model& built)
 {
   auto elements = std::make_shared<Model>();
   forEachKind([&](auto kind) {
     if (kind.kChangesAsHeld)
       kind.of(*elements) = kind.of(built);
+  });
+  return elements;
+}
+}  // namespace
+
+MaterialScaling::MaterialScaling(const Model& built)
+  : built_(changingAsHeld(built)), scaling_(built.bodies.size()), has_material_(built.bodies.size(), 0)
+{
+  forEachKind([&](auto kind) {
     for (const auto& element : kind.of(built))
       has_material_[built.bodyOf(kind.bodyNode(element))] = 1;
   });
-  built_ = std::move(elements);
 }
 
 void MaterialScaling::keepBuilt(const Model& model)
@@ -38,17 +46,15 @@ void MaterialScaling::keepBuilt(const Model& model)
   all_kept_ = true;
 }
 
-void MaterialScaling::dropBuiltIfUnscaled()
+void MaterialScaling::factorsRead(const Model& before)
 {
-  if (!all_kept_ || !std::all_of(scaling_.begin(), scaling_.end(), unit))
-    return;
-  auto elements = std::make_shared<Model>();
-  forEachKind([&](auto kind) {
-    if (kind.kChangesAsHeld)
-      kind.of(*elements) = kind.of(*built_);
-  });
-  built_ = std::move(elements);
-  all_kept_ = false;
+  if (!std::all_of(scaling_.begin(), scaling_.end(), unit))
+    keepBuilt(before);
+  else if (all_kept_)
+  {
+    built_ = changingAsHeld(*built_);
+    all_kept_ = false;
+  }
 }
 
 void MaterialScaling::builtElements(const Model& model, Model& into) const

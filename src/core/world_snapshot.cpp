@@ -155,14 +155,13 @@ void World::restore(const WorldSnapshot& snapshot)
     throw anotherScene(snapshot.summary_, sceneSummary(model_));
   // Read into a copy, so that bytes that fail part way leave this world as it was.
   World next(*this);
-  // The bytes' elements carry their world's factors: the values they multiply must be kept first.
-  next.material_.keepBuilt(next.model_);
   StateArchive reader(snapshot.bytes_->data() + snapshot.body_, snapshot.bytes_->size() - snapshot.body_);
   next.carry(reader);
   if (reader.left() != 0)
     throw std::invalid_argument("snapshot bytes: " + std::to_string(reader.left()) +
                                 " more than this scene's values");
-  next.material_.dropBuiltIfUnscaled();
+  // The bytes' elements carry their world's factors; what those multiply are this world's elements as built.
+  next.material_.factorsRead(model_);
   next.integration_observer_ = std::move(integration_observer_);
   *this = std::move(next);
 }

@@ -23,8 +23,8 @@ struct BodyScaling
 
 /// The values the factors multiply are the elements as built. While every factor is 1 the model's own
 /// elements are those values, so no copy of them is kept (a cloth's springs are 190 bytes a node): the
-/// copy is made when a factor other than 1 is first set, or before a snapshot's bytes are read into the
-/// model. Only the kinds whose elements change as a body is held (a rod's stations) are kept from the start.
+/// copy is made when a factor other than 1 is first set, or when a snapshot's bytes bring one. Only the
+/// kinds whose elements change as a body is held (a rod's stations) are kept from the start.
 class MaterialScaling
 {
 public:
@@ -36,8 +36,10 @@ public:
   void set(Model& model, std::size_t body, const BodyScaling& scaling);
   /// Keeps a copy of `model`'s elements as built if none is kept yet (every factor is 1, so they are).
   void keepBuilt(const Model& model);
-  /// Drops that copy again if every factor is 1 (the model's elements are as built then).
-  void dropBuiltIfUnscaled();
+  /// After factors were read (carry) into a copy of a world whose model is `before` (untouched by the
+  /// read): keeps the elements as built from `before` if a factor is not 1, else drops any copy (the model
+  /// read is as built then).
+  void factorsRead(const Model& before);
   /// The scaling last set for body `body` (all 1 if never set).
   const BodyScaling& of(std::size_t body) const { return scaling_.at(body); }
   /// True if body `body` was built with elements of any kind: a material to scale.

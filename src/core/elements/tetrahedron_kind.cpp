@@ -11,7 +11,8 @@ void TetrahedronKind::ImplicitBlocks::analyze(const Model& model, BlockSystem& s
   std::vector<std::size_t> per_body(model.bodies.size(), 0);
   for (const Tetrahedron& tet : model.tetrahedra)
     ++per_body[model.bodyOf(tet.nodes[0])];
-  largest_solid_ = per_body.empty() ? 0 : *std::max_element(per_body.begin(), per_body.end());
+  const std::size_t largest = per_body.empty() ? 0 : *std::max_element(per_body.begin(), per_body.end());
+  solid_sweeps_ = kSweepsPerCubeRoot * std::cbrt(static_cast<double>(largest));
   slot_.assign(6 * model.tetrahedra.size(), -1);
   system.reservePairs(6 * model.tetrahedra.size());
   for (std::size_t k = 0; k < model.tetrahedra.size(); ++k)
@@ -61,7 +62,7 @@ void TetrahedronKind::ImplicitBlocks::assemble(const NewtonPoint& point, BlockSy
       if (block.nodes[a] >= 0)
         system.diagonal(block.nodes[a]) += block.scaled.blocks[a];
   }
-  system.noteSolidSweeps(kSweepsPerCubeRoot * std::cbrt(static_cast<double>(largest_solid_)));
+  system.noteSolidSweeps(solid_sweeps_);
 }
 
 void TetrahedronKind::ImplicitBlocks::multiply(const Model&, const NodeArray& p, NodeArray& out) const

@@ -73,7 +73,7 @@ struct TetrahedronKind
 
     std::vector<Block> blocks_;    ///< per tetrahedron
     std::vector<int> slot_;        ///< per tetrahedron, six: each node pair's slot, or -1
-    std::size_t largest_solid_ = 0;  ///< the tetrahedra of the body with the most
+    double solid_sweeps_ = 0.0;    ///< CG's sweeps on the body with the most tetrahedra (kSweepsPerCubeRoot)
   };
 };
 
