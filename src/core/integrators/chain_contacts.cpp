@@ -177,8 +177,8 @@ void ChainContacts::place(const Model& model, const NodeArray& start, double h, 
   }
 }
 
-bool ChainContacts::check(const Model& model, const std::vector<SweepRow>& rows, std::size_t first_row,
-                          double* lambda, const NodeArray& start, double h, const NodeArray& x)
+bool ChainContacts::check(const Model& model, const std::vector<SweepRow>& rows, double* lambda,
+                          const NodeArray& start, double h, const NodeArray& x)
 {
   const double h2 = h * h;
   // The tensions [N] of the rows just outside the run nodes[first, end) of `path`, where it has them.
@@ -224,7 +224,7 @@ bool ChainContacts::check(const Model& model, const std::vector<SweepRow>& rows,
   });
   for (const int i : nodes_)
     impulse_.col(i).setZero();
-  for (std::size_t r = first_row; r < rows.size(); ++r)
+  for (std::size_t r = 0; r < rows.size(); ++r)
   {
     const Vec3 d = x.col(rows[r].a) - x.col(rows[r].b);
     const double length = d.norm();

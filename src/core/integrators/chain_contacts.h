@@ -9,8 +9,8 @@
 
 namespace soft_body_sim
 {
-/// A chain's nodes in path order, and between nodes[j] and nodes[j + 1] the row rows[j] (in XPBD's solve
-/// order).
+/// A chain's nodes in path order, and between nodes[j] and nodes[j + 1] the row rows[j] (its place among
+/// XPBD's chain rows, which follow the swept ones in its solve order).
 struct ChainPath
 {
   std::vector<int> nodes;
@@ -62,12 +62,12 @@ public:
   /// prediction x~: finds the held nodes and moves them where their hold puts them. False if none is held.
   bool hold(const Model& model, const ContactQuery& contacts, const NodeArray& start, double h, NodeArray& x);
 
-  /// After a solve, with the rows (`lambda` in the same solve order; the chains' rows from `first_row` on):
+  /// After a solve, with the chains' rows in solve order and their multipliers `lambda` (ChainPath::rows index both):
   /// sets the tensions inside stuck runs, checks every run's contact forces (see the class comment) and
   /// changes the holds that violate them. True if any changed: the caller puts the chains' nodes back with
   /// place() and solves them again.
-  bool check(const Model& model, const std::vector<SweepRow>& rows, std::size_t first_row, double* lambda,
-             const NodeArray& start, double h, const NodeArray& x);
+  bool check(const Model& model, const std::vector<SweepRow>& rows, double* lambda, const NodeArray& start, double h,
+             const NodeArray& x);
 
   /// After the last check of a sub-step of h [s] (the chains at `x`): every node held in the last solve
   /// tells its collider the opposite of its contact force F times h (the class comment), at the surface

@@ -1,5 +1,8 @@
 #include <algorithm>
+#include <array>
 #include <cstdint>
+#include <cstring>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -44,16 +47,44 @@ void solveCell(const PressureCell& cell, const Eigen::VectorXd& inverse_mass, do
     x.col(cell.nodes[k]) += (inverse_mass[cell.nodes[k]] * delta_lambda) * g[k];
 }
 
-/// SweepRow's doubles lie this many apart from one row to the next (for Eigen's strided pgather).
-constexpr std::ptrdiff_t kRowStride = sizeof(SweepRow) / sizeof(double);
-static_assert(sizeof(SweepRow) % sizeof(double) == 0, "SweepRow's doubles must lie a whole number of doubles apart");
+/// What a swept row's update takes besides its ends: SweepRow's four coefficients in its order, so that two
+/// rows' (rest_length, alpha_tilde) and (gamma, inverse_denominator) load whole into packets.
+struct RowCoefficients
+{
+  double rest_length;
+  double alpha_tilde;
+  double gamma;
+  double inverse_denominator;
+
+  void carry(StateArchive& archive) { archive(rest_length, alpha_tilde, gamma, inverse_denominator); }
+};
+static_assert(sizeof(RowCoefficients) == 4 * sizeof(double), "RowCoefficients' doubles must lie side by side");
+
+/// A row swept by Gauss-Seidel: its ends and its coefficients' entry in the solve's table. Rows of the same
+/// parameters and the same sum of their ends' inverse masses share an entry (a cloth's 600,000 springs have
+/// a handful), so a row is 12 bytes where a SweepRow is 40.
+struct SweptRow
+{
+  int a;
+  int b;
+  std::uint32_t coefficients;
+
+  void carry(StateArchive& archive) { archive(a, b, coefficients); }
+};
+
+SweepRow sweepRow(const SweptRow& row, const RowCoefficients& c)
+{
+  return SweepRow{ row.a, row.b, c.rest_length, c.alpha_tilde, c.gamma, c.inverse_denominator };
+}
 
 /// projectDistance on two rows that share no node (of one colour), in one of Eigen's packets: lane by lane
 /// the same operations in the same order, so the same bits as two calls. `lambda` holds their multipliers.
-void projectDistancePair(const SweepRow* rows, const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
-                         NodeArray& x, double* lambda)
+void projectDistancePair(const SweptRow* rows, const RowCoefficients* table, const Eigen::VectorXd& inverse_mass,
+                         const NodeArray& x_prev, NodeArray& x, double* lambda)
 {
-  using Eigen::internal::pgather;
+  using Eigen::internal::ploadu;
+  using Eigen::internal::vec2d_unpackhi;
+  using Eigen::internal::vec2d_unpacklo;
   const std::ptrdiff_t a[2] = { rows[0].a, rows[1].a };
   const std::ptrdiff_t b[2] = { rows[0].b, rows[1].b };
   const ColumnPair x_a = loadColumns(x.data(), a[0], a[1]);
@@ -68,26 +99,30 @@ void projectDistancePair(const SweepRow* rows, const Eigen::VectorXd& inverse_ma
   const Packet ux = dx * inverse_length;
   const Packet uy = dy * inverse_length;
   const Packet uz = dz * inverse_length;
-  const Packet gamma = pgather<double, Packet>(&rows[0].gamma, kRowStride);
+  // Each row's (rest_length, alpha_tilde) and (gamma, inverse_denominator), transposed into the rows' lanes.
+  const RowCoefficients& c_0 = table[rows[0].coefficients];
+  const RowCoefficients& c_1 = table[rows[1].coefficients];
+  const Packet rest_alpha_0 = ploadu<Packet>(&c_0.rest_length), rest_alpha_1 = ploadu<Packet>(&c_1.rest_length);
+  const Packet gamma_inverse_0 = ploadu<Packet>(&c_0.gamma), gamma_inverse_1 = ploadu<Packet>(&c_1.gamma);
+  const Packet gamma = vec2d_unpacklo(gamma_inverse_0, gamma_inverse_1);
   // gradC . (x - x_prev), and 0 without damping (as projectDistance).
   const Packet rate_h = ux * ((x_a.x - previous_a.x) - (x_b.x - previous_b.x)) +
                         uy * ((x_a.y - previous_a.y) - (x_b.y - previous_b.y)) +
                         uz * ((x_a.z - previous_a.z) - (x_b.z - previous_b.z));
   const Packet zero = Eigen::internal::pzero(gamma);
   const Packet c_rate_h = Eigen::internal::pselect(Eigen::internal::pcmp_eq(gamma, zero), zero, rate_h);
-  const Packet c = length - pgather<double, Packet>(&rows[0].rest_length, kRowStride);
-  const Packet inverse_denominator = pgather<double, Packet>(&rows[0].inverse_denominator, kRowStride);
-  const Packet delta_lambda = (-c - pgather<double, Packet>(&rows[0].alpha_tilde, kRowStride) *
-                                        Eigen::internal::ploadu<Packet>(lambda) -
-                               gamma * c_rate_h) *
-                              inverse_denominator;
+  const Packet c = length - vec2d_unpacklo(rest_alpha_0, rest_alpha_1);
+  const Packet inverse_denominator = vec2d_unpackhi(gamma_inverse_0, gamma_inverse_1);
+  const Packet delta_lambda =
+      (-c - vec2d_unpackhi(rest_alpha_0, rest_alpha_1) * ploadu<Packet>(lambda) - gamma * c_rate_h) *
+      inverse_denominator;
   alignas(16) double lanes[4][2];  // delta lambda, u_z, 1 / denominator, |d| of each row
   Eigen::internal::pstore(lanes[0], delta_lambda);
   Eigen::internal::pstore(lanes[1], uz);
   Eigen::internal::pstore(lanes[2], inverse_denominator);
   Eigen::internal::pstore(lanes[3], length);
   // (u_x, u_y) of each row
-  const Packet u_xy[2] = { Eigen::internal::vec2d_unpacklo(ux, uy), Eigen::internal::vec2d_unpackhi(ux, uy) };
+  const Packet u_xy[2] = { vec2d_unpacklo(ux, uy), vec2d_unpackhi(ux, uy) };
   double* const position = x.data();
   for (int l = 0; l < 2; ++l)
   {
@@ -101,8 +136,8 @@ void projectDistancePair(const SweepRow* rows, const Eigen::VectorXd& inverse_ma
     double* const column_b = position + 3 * b[l];
     const Packet step_a = Eigen::internal::pset1<Packet>(move_a) * u_xy[l];
     const Packet step_b = Eigen::internal::pset1<Packet>(move_b) * u_xy[l];
-    Eigen::internal::pstoreu(column_a, Eigen::internal::ploadu<Packet>(column_a) + step_a);
-    Eigen::internal::pstoreu(column_b, Eigen::internal::ploadu<Packet>(column_b) - step_b);
+    Eigen::internal::pstoreu(column_a, ploadu<Packet>(column_a) + step_a);
+    Eigen::internal::pstoreu(column_b, ploadu<Packet>(column_b) - step_b);
     column_a[2] += move_a * lanes[1][l];
     column_b[2] -= move_b * lanes[1][l];
   }
@@ -128,8 +163,8 @@ public:
   void carry(StateArchive& archive, const Model& /*model*/) override
   {
     archive(order_, swept_count_, colour_starts_, last_colour_shares_nodes_, chain_starts_, ordered_nodes_,
-            chain_contacts_, chain_heavy_, swept_chain_, correction_, chain_tension_, rows_, rows_h_, reorder_, lambda_,
-            solved_h_, cell_lambda_);
+            chain_contacts_, chain_heavy_, swept_chain_, correction_, chain_tension_, swept_, coefficients_,
+            coefficient_rows_, chain_rows_, rows_h_, reorder_, lambda_, solved_h_, cell_lambda_);
     if (archive.reading())
       reserveChains();
   }
@@ -190,16 +225,11 @@ private:
       orderRows(model);
       rows_h_ = 0.0;
     }
-    rows_.resize(row_count);  // sized once: no allocation after the first sub-step
     lambda_.setZero(static_cast<Eigen::Index>(row_count));
     cell_lambda_.setZero(static_cast<Eigen::Index>(model.cells.size()));
-    // Rows are stale after a new h or a new order (modelChanged()): the chains' rows are written here, the
-    // swept ones by the first sweep as it goes.
-    const bool stale = h != rows_h_;
-    const double inverse_h2 = 1.0 / (h * h);
-    if (stale)
-      for (std::size_t k = swept_count_; k < row_count; ++k)
-        rows_[k] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
+    // The coefficients are stale after a new h or a new order (modelChanged()).
+    if (h != rows_h_)
+      makeCoefficients(model, h);
     const bool held =
         contacts != nullptr && chain_starts_.size() > 1 && chain_contacts_.hold(model, *contacts, previous_, h, x);
     if (held)
@@ -209,19 +239,7 @@ private:
       predicted_ = x;  // sized once: no allocation after the first sub-step
     for (int iteration = 0; iteration < iterations; ++iteration)
     {
-      if (iteration == 0 && stale)
-      {
-        for (std::size_t k = 0; k < swept_count_; ++k)
-        {
-          rows_[k] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
-          projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
-        }
-        rows_h_ = h;
-      }
-      else
-      {
-        sweepColours(model, x);
-      }
+      sweepColours(model, x);
       // Chains share no free node with the swept rows: each is one block of a block Gauss-Seidel, solved
       // exactly (one Newton step per iteration).
       solveChains(model, h, held, iteration, false, x);
@@ -231,7 +249,7 @@ private:
     // Contacts that the solve's forces break change their holds, and the chains are solved again from
     // their prediction (chain_contacts.h); the swept rows and cells share no free node with them.
     for (int pass = 1;
-         held && chain_contacts_.check(model, rows_, swept_count_, lambda_.data(), previous_, h, x) &&
+         held && chain_contacts_.check(model, chain_rows_, lambda_.data() + swept_count_, previous_, h, x) &&
          pass < ChainContacts::kPasses;
          ++pass)
     {
@@ -246,8 +264,10 @@ private:
       correction_ = x - predicted_;
     // The chains' tensions T = -lambda / h^2 [N] (lambda < 0 pulls the ends together), for the next
     // sub-step's geometric stiffness; compression adds none.
+    const double inverse_h2 = 1.0 / (h * h);
     for (std::size_t k = swept_count_; k < row_count; ++k)
-      chain_tension_[static_cast<Eigen::Index>(k)] = std::max(0.0, -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2);
+      chain_tension_[static_cast<Eigen::Index>(k - swept_count_)] =
+          std::max(0.0, -lambda_[static_cast<Eigen::Index>(k)] * inverse_h2);
     solved_h_ = h;
   }
 
@@ -269,12 +289,14 @@ private:
       const std::size_t count = chain_starts_[c + 1] - first;
       ChainSolver::Outcome outcome = ChainSolver::kLoaded;
       if (!swept_chain_[c])
-        outcome = chains_.solve(&rows_[first], count, model.inverse_mass, previous_, h, chain_tension_.data() + first,
-                                chain_heavy_[c] != 0, holds, &correction_, iteration == 0, x, lambda_.data() + first);
+        outcome = chains_.solve(&chain_rows_[first - swept_count_], count, model.inverse_mass, previous_, h,
+                                chain_tension_.data() + (first - swept_count_), chain_heavy_[c] != 0, holds,
+                                &correction_, iteration == 0, x, lambda_.data() + first);
       swept_chain_[c] = outcome == ChainSolver::kLoaded;
       if (outcome != ChainSolver::kSolved)
         for (std::size_t k = first; k < first + count; ++k)
-          projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
+          projectDistance(chain_rows_[k - swept_count_], model.inverse_mass, previous_, x,
+                          lambda_[static_cast<Eigen::Index>(k)]);
     }
   }
 
@@ -286,10 +308,12 @@ private:
     for (std::size_t c = 0; c + 1 < chain_starts_.size(); ++c)
       for (std::size_t k = chain_starts_[c]; chain_heavy_[c] && k < chain_starts_[c + 1]; ++k)
       {
-        const SweepRow& row = rows_[k];
+        const SweepRow& row = chain_rows_[k - swept_count_];
         const Eigen::Index r = static_cast<Eigen::Index>(k);
         const bool frozen = chain_contacts_.immobile(model, row.a) && chain_contacts_.immobile(model, row.b);
-        lambda_[r] = !frozen ? 0.0 : first_pass ? -chain_tension_[r] * h * h : lambda_[r];
+        lambda_[r] = !frozen                ? 0.0
+                     : first_pass ? -chain_tension_[static_cast<Eigen::Index>(k - swept_count_)] * h * h
+                                  : lambda_[r];
       }
   }
 
@@ -326,8 +350,10 @@ private:
     chain_starts_.clear();
     for (const std::size_t start : partition.chain_starts)
       chain_starts_.push_back(swept_count_ + start);
+    tableRows(model, ends);
+    chain_rows_.resize(order_.size() - swept_count_);
     reserveChains();
-    chain_tension_.setZero(static_cast<Eigen::Index>(order_.size()));
+    chain_tension_.setZero(static_cast<Eigen::Index>(chain_rows_.size()));
     correction_.setZero(3, chain_starts_.size() > 1 ? model.nodeCount() : 0);  // only a chain's solve reads it
     swept_chain_.assign(chain_starts_.size(), 0);
     // Each chain's nodes in path order, and its rows between them, for the contacts in its solve.
@@ -353,12 +379,75 @@ private:
           path.nodes.push_back(a_leads ? a : b);
         }
         path.nodes.push_back(path.nodes.back() == a ? b : a);
-        path.rows.push_back(k);
+        path.rows.push_back(k - swept_count_);
       }
       paths.push_back(std::move(path));
     }
     chain_contacts_.setPaths(model, std::move(paths));
     ordered_nodes_ = model.nodeCount();
+  }
+
+  /// The swept rows' ends and their coefficients' entries: one entry for each distinct kind (spring or
+  /// constraint), rest length, stiffness or compliance, damping and sum of the ends' inverse masses, the
+  /// values sweepRow makes a row's coefficients from, so that rows sharing an entry would have had the same
+  /// coefficients bit for bit. Each entry keeps a row it was made from, to make it again for a new h.
+  void tableRows(const Model& model, const std::vector<std::pair<int, int>>& ends)
+  {
+    const auto bits = [](double value) {
+      std::uint64_t word;
+      std::memcpy(&word, &value, sizeof word);
+      return word;
+    };
+    struct WordsHash
+    {
+      std::size_t operator()(const std::array<std::uint64_t, 5>& words) const
+      {
+        std::uint64_t hash = 14695981039346656037ull;  // FNV-1a over the words
+        for (const std::uint64_t word : words)
+          hash = (hash ^ word) * 1099511628211ull;
+        return static_cast<std::size_t>(hash);
+      }
+    };
+    std::unordered_map<std::array<std::uint64_t, 5>, std::uint32_t, WordsHash> entries;
+    coefficient_rows_.clear();
+    swept_.resize(swept_count_);
+    for (std::size_t k = 0; k < swept_count_; ++k)
+    {
+      const std::uint32_t r = order_[k];
+      const auto [a, b] = ends[r];
+      const double w = model.inverse_mass[a] + model.inverse_mass[b];
+      std::array<std::uint64_t, 5> key;
+      if (r < model.springs.size())
+      {
+        const Spring& s = model.springs[r];
+        key = { 0, bits(s.rest_length), bits(s.stiffness), bits(s.damping), bits(w) };
+      }
+      else
+      {
+        const DistanceConstraint& c = model.constraints[r - model.springs.size()];
+        key = { 1, bits(c.rest_length), bits(c.compliance), 0, bits(w) };
+      }
+      const auto [entry, added] = entries.try_emplace(key, static_cast<std::uint32_t>(coefficient_rows_.size()));
+      if (added)
+        coefficient_rows_.push_back(r);
+      swept_[k] = SweptRow{ a, b, entry->second };
+    }
+    coefficient_rows_.shrink_to_fit();
+    coefficients_.resize(coefficient_rows_.size());
+  }
+
+  /// The swept rows' coefficients and the chains' rows for a (sub)step of h [s].
+  void makeCoefficients(const Model& model, double h)
+  {
+    const double inverse_h2 = 1.0 / (h * h);
+    for (std::size_t e = 0; e < coefficients_.size(); ++e)
+    {
+      const SweepRow row = sweepRow(constraintRow(model, coefficient_rows_[e], h, inverse_h2), model.inverse_mass);
+      coefficients_[e] = RowCoefficients{ row.rest_length, row.alpha_tilde, row.gamma, row.inverse_denominator };
+    }
+    for (std::size_t k = swept_count_; k < order_.size(); ++k)
+      chain_rows_[k - swept_count_] = sweepRow(constraintRow(model, order_[k], h, inverse_h2), model.inverse_mass);
+    rows_h_ = h;
   }
 
   /// Appends `rows` (row indices, in model order) to order_ grouped by a greedy edge colouring
@@ -385,9 +474,10 @@ private:
       const std::size_t end = colour_starts_[c + 1];
       if (!(last_colour_shares_nodes_ && c + 2 == colour_starts_.size()))
         for (; k + 2 <= end; k += 2)
-          projectDistancePair(&rows_[k], model.inverse_mass, previous_, x, lambda_.data() + k);
+          projectDistancePair(&swept_[k], coefficients_.data(), model.inverse_mass, previous_, x, lambda_.data() + k);
       for (; k < end; ++k)
-        projectDistance(rows_[k], model.inverse_mass, previous_, x, lambda_[static_cast<Eigen::Index>(k)]);
+        projectDistance(sweepRow(swept_[k], coefficients_[swept_[k].coefficients]), model.inverse_mass, previous_, x,
+                        lambda_[static_cast<Eigen::Index>(k)]);
     }
   }
 
@@ -422,9 +512,12 @@ private:
   std::vector<std::uint8_t> swept_chain_;  ///< per chain: 1 once the chain solve refused it (solveChains)
   NodeArray predicted_;               ///< [m] the chains' nodes before their solve in this sub-step
   NodeArray correction_;              ///< [m] x - predicted_ after the last sub-step's solve (ChainSolver::solve)
-  Eigen::VectorXd chain_tension_;     ///< [N] per row in solve order: the chains' tensions at the last sub-step
-  std::vector<SweepRow> rows_;        ///< the rows in solve order, valid for h = rows_h_
-  double rows_h_ = 0.0;               ///< [s]; 0 = rows not built
+  Eigen::VectorXd chain_tension_;     ///< [N] per chain row (chain_rows_): the chains' tensions at the last sub-step
+  std::vector<SweptRow> swept_;       ///< the swept rows, order_[0, swept_count_)
+  std::vector<RowCoefficients> coefficients_;  ///< the swept rows' entries (tableRows), valid for h = rows_h_
+  std::vector<std::uint32_t> coefficient_rows_;  ///< per entry, a model row it was made from
+  std::vector<SweepRow> chain_rows_;  ///< the chains' rows, order_[swept_count_, end), valid for h = rows_h_
+  double rows_h_ = 0.0;               ///< [s]; 0 = coefficients not made
   bool reorder_ = false;              ///< the model changed: order and build the rows again
   Eigen::VectorXd lambda_;            ///< per row in solve order, the last sub-step's multipliers
   double solved_h_ = 0.0;             ///< [s] of the last sub-step solved; 0 = none yet
