@@ -308,11 +308,12 @@ private:
     for (std::size_t c = 0; c + 1 < chain_starts_.size(); ++c)
       for (std::size_t k = chain_starts_[c]; chain_heavy_[c] && k < chain_starts_[c + 1]; ++k)
       {
-        const SweepRow& row = chain_rows_[k - swept_count_];
+        const std::size_t chain_row = k - swept_count_;
+        const SweepRow& row = chain_rows_[chain_row];
         const Eigen::Index r = static_cast<Eigen::Index>(k);
         const bool frozen = chain_contacts_.immobile(model, row.a) && chain_contacts_.immobile(model, row.b);
-        lambda_[r] = !frozen                ? 0.0
-                     : first_pass ? -chain_tension_[static_cast<Eigen::Index>(k - swept_count_)] * h * h
+        lambda_[r] = !frozen      ? 0.0
+                     : first_pass ? -chain_tension_[static_cast<Eigen::Index>(chain_row)] * h * h
                                   : lambda_[r];
       }
   }
