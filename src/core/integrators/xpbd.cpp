@@ -8,6 +8,7 @@
 
 #include "core/elements/column_packets.h"
 #include "core/elements/edge_colouring.h"
+#include "core/elements/wide_columns.h"
 #include "core/integrators/chain_contacts.h"
 #include "core/solvers/chain_solver.h"
 #include "core/integrators/integrator_kit.h"
@@ -141,6 +142,113 @@ void projectDistancePair(const SweptRow* rows, const RowCoefficients* table, con
     column_a[2] += move_a * lanes[1][l];
     column_b[2] -= move_b * lanes[1][l];
   }
+}
+
+/// Four rows' updates as projectDistanceQuad works them out, before they move their ends.
+struct QuadMove
+{
+  std::ptrdiff_t a[4];
+  std::ptrdiff_t b[4];
+  alignas(32) double lanes[4][4];  // delta lambda, u_z, 1 / denominator, |d| of each row
+  __m128d u_xy[4];                 // (u_x, u_y) of each row
+};
+
+/// The updates of four rows that share no node (AVX2; hasWideLanes): lane by lane the same operations in the
+/// same order as projectDistance, so the same bits as four calls.
+[[gnu::target("avx2"), gnu::always_inline]] inline void quadMove(const SweptRow* rows, const RowCoefficients* table,
+                                                                 const NodeArray& x_prev, const NodeArray& x,
+                                                                 const double* lambda, QuadMove& move)
+{
+  for (int l = 0; l < 4; ++l)
+  {
+    move.a[l] = rows[l].a;
+    move.b[l] = rows[l].b;
+  }
+  const ColumnQuad x_a = loadColumns4(x.data(), move.a);
+  const ColumnQuad x_b = loadColumns4(x.data(), move.b);
+  const ColumnQuad previous_a = loadColumns4(x_prev.data(), move.a);
+  const ColumnQuad previous_b = loadColumns4(x_prev.data(), move.b);
+  const __m256d dx = x_a.x - x_b.x;
+  const __m256d dy = x_a.y - x_b.y;
+  const __m256d dz = x_a.z - x_b.z;
+  const __m256d length = _mm256_sqrt_pd(dx * dx + dy * dy + dz * dz);
+  const __m256d inverse_length = 1.0 / length;
+  const __m256d ux = dx * inverse_length;
+  const __m256d uy = dy * inverse_length;
+  const __m256d uz = dz * inverse_length;
+  // Each row's four coefficients (RowCoefficients) transposed into the rows' lanes.
+  __m256d coefficient[4];
+  for (int l = 0; l < 4; ++l)
+    coefficient[l] = _mm256_loadu_pd(&table[rows[l].coefficients].rest_length);
+  const __m256d low_01 = _mm256_unpacklo_pd(coefficient[0], coefficient[1]);   // (r0, r1, g0, g1)
+  const __m256d high_01 = _mm256_unpackhi_pd(coefficient[0], coefficient[1]);  // (a0, a1, i0, i1)
+  const __m256d low_23 = _mm256_unpacklo_pd(coefficient[2], coefficient[3]);
+  const __m256d high_23 = _mm256_unpackhi_pd(coefficient[2], coefficient[3]);
+  const __m256d rest_length = _mm256_permute2f128_pd(low_01, low_23, 0x20);
+  const __m256d gamma = _mm256_permute2f128_pd(low_01, low_23, 0x31);
+  const __m256d alpha_tilde = _mm256_permute2f128_pd(high_01, high_23, 0x20);
+  const __m256d inverse_denominator = _mm256_permute2f128_pd(high_01, high_23, 0x31);
+  // gradC . (x - x_prev), and 0 without damping (as projectDistance).
+  const __m256d rate_h = ux * ((x_a.x - previous_a.x) - (x_b.x - previous_b.x)) +
+                         uy * ((x_a.y - previous_a.y) - (x_b.y - previous_b.y)) +
+                         uz * ((x_a.z - previous_a.z) - (x_b.z - previous_b.z));
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d c_rate_h = _mm256_blendv_pd(rate_h, zero, _mm256_cmp_pd(gamma, zero, _CMP_EQ_OQ));
+  const __m256d c = length - rest_length;
+  const __m256d delta_lambda = (-c - alpha_tilde * _mm256_loadu_pd(lambda) - gamma * c_rate_h) * inverse_denominator;
+  _mm256_store_pd(move.lanes[0], delta_lambda);
+  _mm256_store_pd(move.lanes[1], uz);
+  _mm256_store_pd(move.lanes[2], inverse_denominator);
+  _mm256_store_pd(move.lanes[3], length);
+  lanePairs(ux, uy, move.u_xy);
+}
+
+/// Moves the ends of quadMove's four rows and adds to their multipliers `lambda`, row by row.
+[[gnu::target("avx2"), gnu::always_inline]] inline void applyQuadMove(const QuadMove& move,
+                                                                      const Eigen::VectorXd& inverse_mass,
+                                                                      NodeArray& x, double* lambda)
+{
+  double* const position = x.data();
+  for (int l = 0; l < 4; ++l)
+  {
+    // As projectDistance: rows that cannot move, and coincident nodes (no direction), are left.
+    if (move.lanes[2][l] == 0.0 || move.lanes[3][l] < kMinSpringLength)
+      continue;
+    const double delta_lambda = move.lanes[0][l];
+    lambda[l] += delta_lambda;
+    const double move_a = inverse_mass[move.a[l]] * delta_lambda;
+    const double move_b = inverse_mass[move.b[l]] * delta_lambda;
+    double* const column_a = position + 3 * move.a[l];
+    double* const column_b = position + 3 * move.b[l];
+    _mm_storeu_pd(column_a, _mm_loadu_pd(column_a) + _mm_set1_pd(move_a) * move.u_xy[l]);
+    _mm_storeu_pd(column_b, _mm_loadu_pd(column_b) - _mm_set1_pd(move_b) * move.u_xy[l]);
+    column_a[2] += move_a * move.lanes[1][l];
+    column_b[2] -= move_b * move.lanes[1][l];
+  }
+}
+
+/// The rows [k, end) of one colour four at a time (AVX2), two quads worked out before either moves its
+/// ends, so that the processor overlaps their square roots and divisions: returns where it stopped.
+[[gnu::target("avx2")]] std::size_t projectDistanceQuads(const SweptRow* rows, std::size_t k, std::size_t end,
+                                                         const RowCoefficients* table,
+                                                         const Eigen::VectorXd& inverse_mass, const NodeArray& x_prev,
+                                                         NodeArray& x, double* lambda)
+{
+  QuadMove first;
+  QuadMove second;
+  for (; k + 8 <= end; k += 8)
+  {
+    quadMove(rows + k, table, x_prev, x, lambda + k, first);
+    quadMove(rows + k + 4, table, x_prev, x, lambda + k + 4, second);
+    applyQuadMove(first, inverse_mass, x, lambda + k);
+    applyQuadMove(second, inverse_mass, x, lambda + k + 4);
+  }
+  for (; k + 4 <= end; k += 4)
+  {
+    quadMove(rows + k, table, x_prev, x, lambda + k, first);
+    applyQuadMove(first, inverse_mass, x, lambda + k);
+  }
+  return k;
 }
 
 /// Extended position-based dynamics (Macklin, Mueller, Chentanez 2016), one call per sub-step as in
@@ -465,17 +573,23 @@ private:
   }
 
   /// One Gauss-Seidel sweep over the swept rows, colour by colour. The rows of a colour share no node, so
-  /// updating two of them at once (projectDistancePair) is the same arithmetic in the same order as one by
-  /// one: the same bits.
+  /// updating four (projectDistanceQuads, with AVX2) or two of them at once (projectDistancePair) is the
+  /// same arithmetic in the same order as one by one: the same bits on every processor.
   void sweepColours(const Model& model, NodeArray& x)
   {
+    const bool wide = hasWideLanes();
     for (std::size_t c = 0; c + 1 < colour_starts_.size(); ++c)
     {
       std::size_t k = colour_starts_[c];
       const std::size_t end = colour_starts_[c + 1];
       if (!(last_colour_shares_nodes_ && c + 2 == colour_starts_.size()))
+      {
+        if (wide)
+          k = projectDistanceQuads(swept_.data(), k, end, coefficients_.data(), model.inverse_mass, previous_, x,
+                                   lambda_.data());
         for (; k + 2 <= end; k += 2)
           projectDistancePair(&swept_[k], coefficients_.data(), model.inverse_mass, previous_, x, lambda_.data() + k);
+      }
       for (; k < end; ++k)
         projectDistance(sweepRow(swept_[k], coefficients_[swept_[k].coefficients]), model.inverse_mass, previous_, x,
                         lambda_[static_cast<Eigen::Index>(k)]);

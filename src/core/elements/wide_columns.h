@@ -1,0 +1,56 @@
+// Four nodes' columns as AVX2 registers, for the kernels that update four elements at once (springs, xpbd
+// rows) on a processor that has AVX2 (hasWideLanes). Each function is compiled for AVX2 alone, without
+// FMA: lane by lane the same operations and roundings as the scalar and the two-lane (column_packets.h)
+// kernels, so the same bits on every processor.
+#pragma once
+
+#include <cstddef>
+
+#include <immintrin.h>
+
+namespace soft_body_sim
+{
+#define SOFT_BODY_SIM_WIDE [[gnu::target("avx2"), gnu::always_inline]] inline
+
+/// Whether this processor runs the four-lane kernels (AVX2), asked once.
+inline bool hasWideLanes()
+{
+  static const bool wide = __builtin_cpu_supports("avx2");
+  return wide;
+}
+
+/// Columns i[0..3] of a 3 x N column-major array as (x_i0, ..., x_i3), (y_...), (z_...).
+struct ColumnQuad
+{
+  __m256d x, y, z;
+};
+
+/// Each column's (x, y) loaded whole and transposed in registers, its z gathered by lanes; no load leaves
+/// the array.
+SOFT_BODY_SIM_WIDE ColumnQuad loadColumns4(const double* array, const std::ptrdiff_t i[4])
+{
+  const double* const c0 = array + 3 * i[0];
+  const double* const c1 = array + 3 * i[1];
+  const double* const c2 = array + 3 * i[2];
+  const double* const c3 = array + 3 * i[3];
+  // (x0, y0, x2, y2) and (x1, y1, x3, y3)
+  const __m256d xy_02 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(c0)), _mm_loadu_pd(c2), 1);
+  const __m256d xy_13 = _mm256_insertf128_pd(_mm256_castpd128_pd256(_mm_loadu_pd(c1)), _mm_loadu_pd(c3), 1);
+  const __m128d z_01 = _mm_loadh_pd(_mm_load_sd(c0 + 2), c1 + 2);
+  const __m128d z_23 = _mm_loadh_pd(_mm_load_sd(c2 + 2), c3 + 2);
+  return { _mm256_unpacklo_pd(xy_02, xy_13), _mm256_unpackhi_pd(xy_02, xy_13),
+           _mm256_insertf128_pd(_mm256_castpd128_pd256(z_01), z_23, 1) };
+}
+
+/// Lane l's (x, y) of two packets x, y as SSE2 halves, for the lanes' scatters: xy[l] = (x_l, y_l).
+SOFT_BODY_SIM_WIDE void lanePairs(__m256d x, __m256d y, __m128d xy[4])
+{
+  const __m256d low = _mm256_unpacklo_pd(x, y);   // (x0, y0, x2, y2)
+  const __m256d high = _mm256_unpackhi_pd(x, y);  // (x1, y1, x3, y3)
+  xy[0] = _mm256_castpd256_pd128(low);
+  xy[1] = _mm256_castpd256_pd128(high);
+  xy[2] = _mm256_extractf128_pd(low, 1);
+  xy[3] = _mm256_extractf128_pd(high, 1);
+}
+
+}  // namespace soft_body_sim
