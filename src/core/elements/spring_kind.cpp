@@ -22,31 +22,31 @@ void SpringKind::ImplicitBlocks::assemble(const NewtonPoint& point, BlockSystem&
   const double h = point.h;
   NodeArray& rhs = system.rhs();
   blocks_.resize(model.springs.size());
-  length_.resize(model.springs.size());
-  inverse_length_.resize(model.springs.size());
   // Each spring's axis as springAxis gives it, but with one division where it takes four (u = d / l,
   // then L / l below), in a loop of its own: short, so that the processor overlaps the square roots and
-  // divisions of many springs (on a rope, they were most of the assembly's time).
+  // divisions of many springs (on a rope, they were most of the assembly's time). Until the next loop
+  // makes the block's a and b, they hold the length and its reciprocal (0 if the ends coincide): no
+  // arrays of their own (16 bytes a spring).
   for (std::size_t k = 0; k < model.springs.size(); ++k)
   {
     const Spring& s = model.springs[k];
+    Block& block = blocks_[k];
     const Vec3 axis = point.x.col(s.a) - point.x.col(s.b);
-    const double length = axis.norm();
-    length_[k] = length;
-    inverse_length_[k] = length < kMinSpringLength ? 0.0 : 1.0 / length;
-    blocks_[k].u = axis * inverse_length_[k];
+    block.a = axis.norm();
+    block.b = block.a < kMinSpringLength ? 0.0 : 1.0 / block.a;
+    block.u = axis * block.b;
   }
   for (std::size_t k = 0; k < model.springs.size(); ++k)
   {
     const Spring& s = model.springs[k];
     Block& block = blocks_[k];
-    const double inverse_length = inverse_length_[k];
+    const double length = block.a;
+    const double inverse_length = block.b;
     if (inverse_length == 0.0)
     {
       block = Block{ Vec3::Zero(), 0.0, 0.0 };  // coincident ends: no force, no block
       continue;
     }
-    const double length = length_[k];
     const double transverse = std::max(0.0, 1.0 - s.rest_length * inverse_length);
     block.a = h * h * s.stiffness * (1.0 - transverse) + h * s.damping;
     block.b = h * h * s.stiffness * transverse;

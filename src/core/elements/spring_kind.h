@@ -84,10 +84,8 @@ struct SpringKind
       double a;
       double b;
     };
-    std::vector<Block> blocks_;           ///< per spring
-    std::vector<double> length_;          ///< per spring: its length [m]
-    std::vector<double> inverse_length_;  ///< per spring: 1 / its length [1/m], 0 if its ends coincide
-    std::vector<int> slot_;               ///< per spring: its slot in the pattern, or -1 (an end pinned)
+    std::vector<Block> blocks_;  ///< per spring
+    std::vector<int> slot_;      ///< per spring: its slot in the pattern, or -1 (an end pinned)
   };
 };
 

@@ -154,20 +154,17 @@ private:
     {
       const NodeArray& v_k = state.velocity;
       // x_lin and the offset x_n + h v_k - x_lin at which K acts: x_lin = x_n on the first iteration (the
-      // offset h v_k), x_n + h v_k on the others (no offset).
+      // offset h v_k), x_n + h v_k on the others (no offset), in the state's positions (linearPositions).
       offset_.setZero(3, n);
-      if (k > 0)
-        linear_x_ = start_x_;
-      for (int i = 0; i < n; ++i)
+      if (k == 0)
       {
-        if (!model.isFree(i))
-          continue;
-        if (k == 0)
-          offset_.col(i) = h * v_k.col(i);
-        else
-          linear_x_.col(i) += h * v_k.col(i);
+        for (int i = 0; i < n; ++i)
+          if (model.isFree(i))
+            offset_.col(i) = h * v_k.col(i);
       }
-      assemble(NewtonPoint{ model, k == 0 ? start_x_ : linear_x_, v_k, state.twist, offset_, h }, k == 0);
+      else
+        linearPositions(model, state, h);
+      assemble(NewtonPoint{ model, k == 0 ? start_x_ : state.position, v_k, state.twist, offset_, h }, k == 0);
       solve(model);
       for (int i = 0; i < n; ++i)
         if (model.isFree(i))
@@ -277,15 +274,21 @@ private:
     system_.solve(Blocks{ model, kinds_, surface_holds_ }, surface_holds_.empty(), delta_v_);
   }
 
-  /// The system at the iterate v_k: linearised at x_lin = x_n + h v_k (the offset 0), its rhs the residual.
-  void assembleAtIterate(const Model& model, const State& state, double h)
+  /// x_lin = x_n + h v_k, the point of the iterations after the first, in the state's positions: they are
+  /// x_n + h v at the step's end (finishStep), and nothing reads them in between (x_n is start_x_).
+  void linearPositions(const Model& model, State& state, double h) const
   {
-    offset_.setZero();
-    linear_x_ = start_x_;
     for (int i = 0; i < model.nodeCount(); ++i)
       if (model.isFree(i))
-        linear_x_.col(i) += h * state.velocity.col(i);
-    assemble(NewtonPoint{ model, linear_x_, state.velocity, state.twist, offset_, h }, false);
+        state.position.col(i) = start_x_.col(i) + h * state.velocity.col(i);
+  }
+
+  /// The system at the iterate v_k: linearised at x_lin = x_n + h v_k (the offset 0), its rhs the residual.
+  void assembleAtIterate(const Model& model, State& state, double h)
+  {
+    offset_.setZero();
+    linearPositions(model, state, h);
+    assemble(NewtonPoint{ model, state.position, state.velocity, state.twist, offset_, h }, false);
   }
 
   /// NewtonRule's test on the assembled residual r (rhs): sqrt(sum |r_i|^2 / m_i / sum m_i) at most
@@ -317,7 +320,7 @@ private:
   ColliderHolds collider_holds_;
   SurfaceHolds surface_holds_;
   bool analyzed_ = false;  ///< the system holds the pattern of the current model
-  NodeArray start_x_, start_v_, linear_x_, offset_;
+  NodeArray start_x_, start_v_, offset_;
   NodeArray delta_v_;
   ContactQuery* contacts_ = nullptr;  ///< the colliders during a step with contacts on solids or cloths
 };
