@@ -21,6 +21,7 @@
 
 #include <gtest/gtest.h>
 
+#include "core/elements/wide_columns.h"
 #include "soft_body_sim/scene/scene_loader.h"
 #include "test_util.h"
 
@@ -257,6 +258,32 @@ TEST(Determinism, EveryExampleAndHardCaseSceneGivesItsPinnedBits)
   {
     EXPECT_EQ(checked, kPinned.size()) << "a pinned scene or integrator no longer runs";
   }
+}
+
+TEST(Determinism, TheTwoLaneKernelsOfAProcessorWithoutAvx2GiveThePinnedBits)
+{
+  // The spring forces and xpbd's sweep take four springs or rows at a time where the processor has AVX2,
+  // two (SSE2) where it has not, each lane with the scalar operations (wide_columns.h): every run of the
+  // first test with two lanes, on the same pinned bits.
+  if (!hasWideLanes())
+    GTEST_SKIP() << "no AVX2 here: the first test ran the two lanes";
+  useWideLanes(false);
+  std::size_t checked = 0;
+  for (const std::string& path : scenes())
+  {
+    const SceneDef scene = loadSceneFile(std::string(SOURCE_DIR) + "/" + path);
+    for (const IntegratorType integrator : stableIntegrators(scene))
+    {
+      const std::string name = integratorName(integrator);
+      const Pinned* pinned = pinnedHash(path, name);
+      ASSERT_NE(pinned, nullptr) << path << " with " << name << " has no pinned hash";
+      EXPECT_EQ(run(scene, integrator), pinned->hash) << path << " with " << name << ", two lanes";
+      ++checked;
+    }
+  }
+  useWideLanes(true);
+  EXPECT_TRUE(hasWideLanes());
+  EXPECT_EQ(checked, kPinned.size());
 }
 
 TEST(Determinism, AWorldClonedOrRestoredMidRunStepsOnToTheSameBits)

@@ -12,12 +12,11 @@ namespace soft_body_sim
 {
 #define SOFT_BODY_SIM_WIDE [[gnu::target("avx2"), gnu::always_inline]] inline
 
-/// Whether this processor runs the four-lane kernels (AVX2), asked once.
-inline bool hasWideLanes()
-{
-  static const bool wide = __builtin_cpu_supports("avx2");
-  return wide;
-}
+/// Whether the four-lane kernels run: the processor has AVX2 (asked once), unless useWideLanes(false).
+bool hasWideLanes();
+/// With false, the kernels take the two lanes (column_packets.h) that a processor without AVX2 takes; with
+/// true, four again where the processor has AVX2. For the tests, which check that both give the same bits.
+void useWideLanes(bool on);
 
 /// Columns i[0..3] of a 3 x N column-major array as (x_i0, ..., x_i3), (y_...), (z_...).
 struct ColumnQuad
