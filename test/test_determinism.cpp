@@ -232,6 +232,27 @@ const Pinned* pinnedHash(const std::string& path, const std::string& integrator)
   return pinned == kPinned.end() ? nullptr : &*pinned;
 }
 
+/// check(scene, integrator, what, pinned) for every pinned run (each scene with each integrator that keeps
+/// it stable; `what` names them), then that every pinned run was one.
+template <class Check>
+void forEachPinnedRun(Check check)
+{
+  std::size_t checked = 0;
+  for (const std::string& path : scenes())
+  {
+    const SceneDef scene = loadSceneFile(std::string(SOURCE_DIR) + "/" + path);
+    for (const IntegratorType integrator : stableIntegrators(scene))
+    {
+      const std::string name = integratorName(integrator);
+      const Pinned* pinned = pinnedHash(path, name);
+      ASSERT_NE(pinned, nullptr) << path << " with " << name << " has no pinned hash";
+      check(scene, integrator, path + " with " + name, *pinned);
+      ++checked;
+    }
+  }
+  EXPECT_EQ(checked, kPinned.size()) << "a pinned scene or integrator no longer runs";
+}
+
 TEST(Determinism, EveryExampleAndHardCaseSceneGivesItsPinnedBits)
 {
   const bool print = std::getenv("SOFT_BODY_SIM_PRINT_HASHES") != nullptr;
@@ -268,22 +289,11 @@ TEST(Determinism, TheTwoLaneKernelsOfAProcessorWithoutAvx2GiveThePinnedBits)
   if (!hasWideLanes())
     GTEST_SKIP() << "no AVX2 here: the first test ran the two lanes";
   useWideLanes(false);
-  std::size_t checked = 0;
-  for (const std::string& path : scenes())
-  {
-    const SceneDef scene = loadSceneFile(std::string(SOURCE_DIR) + "/" + path);
-    for (const IntegratorType integrator : stableIntegrators(scene))
-    {
-      const std::string name = integratorName(integrator);
-      const Pinned* pinned = pinnedHash(path, name);
-      ASSERT_NE(pinned, nullptr) << path << " with " << name << " has no pinned hash";
-      EXPECT_EQ(run(scene, integrator), pinned->hash) << path << " with " << name << ", two lanes";
-      ++checked;
-    }
-  }
+  forEachPinnedRun([](const SceneDef& scene, IntegratorType integrator, const std::string& what, const Pinned& pinned) {
+    EXPECT_EQ(run(scene, integrator), pinned.hash) << what << ", two lanes";
+  });
   useWideLanes(true);
   EXPECT_TRUE(hasWideLanes());
-  EXPECT_EQ(checked, kPinned.size());
 }
 
 TEST(Determinism, AWorldClonedOrRestoredMidRunStepsOnToTheSameBits)
@@ -292,38 +302,27 @@ TEST(Determinism, AWorldClonedOrRestoredMidRunStepsOnToTheSameBits)
   // the targets jump): a clone (World's copy) stepped on with the same inputs, the world itself stepped
   // on, restored to a snapshot of that moment and stepped on again, and a world built afresh from the
   // scene, restored from that snapshot's bytes, each end on the run's pinned bits.
-  std::size_t checked = 0;
-  for (const std::string& path : scenes())
-  {
-    const SceneDef scene = loadSceneFile(std::string(SOURCE_DIR) + "/" + path);
-    for (const IntegratorType integrator : stableIntegrators(scene))
-    {
-      const std::string name = integratorName(integrator);
-      const Pinned* pinned = pinnedHash(path, name);
-      ASSERT_NE(pinned, nullptr) << path << " with " << name << " has no pinned hash";
-      Rollout rollout(scene, integrator);
-      const int split = rollout.steps / 3;
-      rollout.stepInputs(rollout.world, 0, split);
-      World clone(rollout.world);
-      const WorldSnapshot moment = rollout.world.snapshot();
-      const std::string bytes = moment.toBytes();
-      rollout.stepInputs(rollout.world, split, rollout.steps);
-      EXPECT_EQ(hashOf(rollout.world), pinned->hash) << path << " with " << name;
-      rollout.stepInputs(clone, split, rollout.steps);
-      EXPECT_EQ(hashOf(clone), pinned->hash) << path << " with " << name << ": the clone";
-      rollout.world.restore(moment);
-      EXPECT_EQ(rollout.world.stepCount(), split);
-      rollout.stepInputs(rollout.world, split, rollout.steps);
-      EXPECT_EQ(hashOf(rollout.world), pinned->hash) << path << " with " << name << ": restored";
-      Rollout fresh(scene, integrator);
-      fresh.world.restore(WorldSnapshot::fromBytes(bytes));
-      EXPECT_EQ(fresh.world.stepCount(), split);
-      fresh.stepInputs(fresh.world, split, rollout.steps);
-      EXPECT_EQ(hashOf(fresh.world), pinned->hash) << path << " with " << name << ": from bytes";
-      ++checked;
-    }
-  }
-  EXPECT_EQ(checked, kPinned.size());
+  forEachPinnedRun([](const SceneDef& scene, IntegratorType integrator, const std::string& what, const Pinned& pinned) {
+    Rollout rollout(scene, integrator);
+    const int split = rollout.steps / 3;
+    rollout.stepInputs(rollout.world, 0, split);
+    World clone(rollout.world);
+    const WorldSnapshot moment = rollout.world.snapshot();
+    const std::string bytes = moment.toBytes();
+    rollout.stepInputs(rollout.world, split, rollout.steps);
+    EXPECT_EQ(hashOf(rollout.world), pinned.hash) << what;
+    rollout.stepInputs(clone, split, rollout.steps);
+    EXPECT_EQ(hashOf(clone), pinned.hash) << what << ": the clone";
+    rollout.world.restore(moment);
+    EXPECT_EQ(rollout.world.stepCount(), split);
+    rollout.stepInputs(rollout.world, split, rollout.steps);
+    EXPECT_EQ(hashOf(rollout.world), pinned.hash) << what << ": restored";
+    Rollout fresh(scene, integrator);
+    fresh.world.restore(WorldSnapshot::fromBytes(bytes));
+    EXPECT_EQ(fresh.world.stepCount(), split);
+    fresh.stepInputs(fresh.world, split, rollout.steps);
+    EXPECT_EQ(hashOf(fresh.world), pinned.hash) << what << ": from bytes";
+  });
 }
 
 TEST(Determinism, BytesOfAnotherMaterialScalingStepOnWithTheirSprings)
