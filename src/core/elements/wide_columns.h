@@ -10,6 +10,8 @@
 
 namespace soft_body_sim
 {
+/// A helper of the four-lane kernels: compiled for AVX2 and inlined into them (functions compiled for AVX2
+/// alone, `[[gnu::target("avx2")]]`, which a caller runs only where hasWideLanes).
 #define SOFT_BODY_SIM_WIDE [[gnu::target("avx2"), gnu::always_inline]] inline
 
 /// Whether the four-lane kernels run: the processor has AVX2 (asked once), unless useWideLanes(false).

@@ -144,7 +144,7 @@ void projectDistancePair(const SweptRow* rows, const RowCoefficients* table, con
   }
 }
 
-/// Four rows' updates as projectDistanceQuad works them out, before they move their ends.
+/// Four rows' updates as quadMove works them out, before applyQuadMove moves their ends.
 struct QuadMove
 {
   std::ptrdiff_t a[4];
@@ -155,9 +155,8 @@ struct QuadMove
 
 /// The updates of four rows that share no node (AVX2; hasWideLanes): lane by lane the same operations in the
 /// same order as projectDistance, so the same bits as four calls.
-[[gnu::target("avx2"), gnu::always_inline]] inline void quadMove(const SweptRow* rows, const RowCoefficients* table,
-                                                                 const NodeArray& x_prev, const NodeArray& x,
-                                                                 const double* lambda, QuadMove& move)
+SOFT_BODY_SIM_WIDE void quadMove(const SweptRow* rows, const RowCoefficients* table, const NodeArray& x_prev,
+                                 const NodeArray& x, const double* lambda, QuadMove& move)
 {
   for (int l = 0; l < 4; ++l)
   {
@@ -204,9 +203,8 @@ struct QuadMove
 }
 
 /// Moves the ends of quadMove's four rows and adds to their multipliers `lambda`, row by row.
-[[gnu::target("avx2"), gnu::always_inline]] inline void applyQuadMove(const QuadMove& move,
-                                                                      const Eigen::VectorXd& inverse_mass,
-                                                                      NodeArray& x, double* lambda)
+SOFT_BODY_SIM_WIDE void applyQuadMove(const QuadMove& move, const Eigen::VectorXd& inverse_mass, NodeArray& x,
+                                      double* lambda)
 {
   double* const position = x.data();
   for (int l = 0; l < 4; ++l)
