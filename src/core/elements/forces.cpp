@@ -16,17 +16,12 @@ namespace soft_body_sim
 {
 namespace
 {
-// forcePerLength takes AVX2's packets too, always inlined into the four-lane kernel (which is compiled for
-// AVX2): no such packet crosses a call, so GCC's note on their calling convention (given where the file
-// ends, where the template is instantiated) does not apply.
-#pragma GCC diagnostic ignored "-Wpsabi"
 /// The force on end a per unit of d = x_a - x_b, the Spring law with u = d / |d| taken as one division:
 ///   F_a = -(k (|d| - rest_length) + c (v_a - v_b) . d / |d|) / |d|  d.
-/// `rate` is (v_a - v_b) . d [m^2/s] and `length` |d| [m]; T is a double, a Packet or
-/// an AVX2 __m256d.
+/// `rate` is (v_a - v_b) . d [m^2/s] and `length` |d| [m]; T is a double or a Packet (the four-lane
+/// kernel writes it out: a function not compiled for AVX2 may not return AVX2's packets).
 template <typename T>
-[[gnu::always_inline]] inline T forcePerLength(const T& length, const T& rate, const T& rest_length,
-                                               const T& stiffness, const T& damping)
+T forcePerLength(const T& length, const T& rate, const T& rest_length, const T& stiffness, const T& damping)
 {
   const T inverse_length = 1.0 / length;
   return -(stiffness * (length - rest_length) + damping * rate * inverse_length) * inverse_length;
@@ -77,9 +72,12 @@ namespace
     const __m256d dz = x_a.z - x_b.z;
     const __m256d rate = (v_a.x - v_b.x) * dx + (v_a.y - v_b.y) * dy + (v_a.z - v_b.z) * dz;
     const __m256d length = _mm256_sqrt_pd(dx * dx + dy * dy + dz * dz);
-    const __m256d per_length =
-        forcePerLength(length, rate, _mm256_loadu_pd(&springs.rest_length[k]), _mm256_loadu_pd(&springs.stiffness[k]),
-                       _mm256_loadu_pd(&springs.damping[k]));
+    // forcePerLength, lane by lane.
+    const __m256d rest_length = _mm256_loadu_pd(&springs.rest_length[k]);
+    const __m256d stiffness = _mm256_loadu_pd(&springs.stiffness[k]);
+    const __m256d damping = _mm256_loadu_pd(&springs.damping[k]);
+    const __m256d inverse_length = 1.0 / length;
+    const __m256d per_length = -(stiffness * (length - rest_length) + damping * rate * inverse_length) * inverse_length;
     __m128d f_xy[4];
     lanePairs(per_length * dx, per_length * dy, f_xy);
     alignas(32) double f_z[4];
