@@ -5,6 +5,8 @@
 
 #include <Eigen/Core>
 
+#include <emmintrin.h>
+
 namespace soft_body_sim
 {
 /// One of Eigen's packets of two doubles (SSE2's register); GCC and Clang give such a vector type the
@@ -28,6 +30,21 @@ inline ColumnPair loadColumns(const double* array, std::ptrdiff_t i0, std::ptrdi
   const Packet yz_1 = Eigen::internal::ploadu<Packet>(array + 3 * i1 + 1);
   return { Eigen::internal::vec2d_unpacklo(xy_0, xy_1), Eigen::internal::vec2d_unpackhi(xy_0, xy_1),
            Eigen::internal::vec2d_unpackhi(yz_0, yz_1) };
+}
+
+/// Column i of a 3 x N column-major array plus (xy, z), and minus: one element's share on each of its two
+/// ends, lane by lane in the scatters of the two- and four-lane kernels.
+[[gnu::always_inline]] inline void addToColumn(double* array, std::ptrdiff_t i, const Packet& xy, double z)
+{
+  double* const column = array + 3 * i;
+  _mm_storeu_pd(column, _mm_loadu_pd(column) + xy);
+  column[2] += z;
+}
+[[gnu::always_inline]] inline void subtractFromColumn(double* array, std::ptrdiff_t i, const Packet& xy, double z)
+{
+  double* const column = array + 3 * i;
+  _mm_storeu_pd(column, _mm_loadu_pd(column) - xy);
+  column[2] -= z;
 }
 
 }  // namespace soft_body_sim

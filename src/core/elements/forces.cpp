@@ -88,12 +88,8 @@ namespace
     {
       if (lengths[l] < kMinSpringLength)
         continue;  // coincident nodes: the direction is undefined
-      double* const sum_a = sum + 3 * a[l];
-      double* const sum_b = sum + 3 * b[l];
-      _mm_storeu_pd(sum_a, _mm_loadu_pd(sum_a) + f_xy[l]);
-      _mm_storeu_pd(sum_b, _mm_loadu_pd(sum_b) - f_xy[l]);
-      sum_a[2] += f_z[l];
-      sum_b[2] -= f_z[l];
+      addToColumn(sum, a[l], f_xy[l], f_z[l]);
+      subtractFromColumn(sum, b[l], f_xy[l], f_z[l]);
     }
   }
   return k;
@@ -140,12 +136,8 @@ void accumulateSpringForces(const SpringArrays& springs, const NodeArray& x, con
     {
       if (lengths[l] < kMinSpringLength)
         continue;  // coincident nodes: the direction is undefined
-      double* const sum_a = sum + 3 * a[l];
-      double* const sum_b = sum + 3 * b[l];
-      Eigen::internal::pstoreu(sum_a, Eigen::internal::ploadu<Packet>(sum_a) + f_xy[l]);
-      Eigen::internal::pstoreu(sum_b, Eigen::internal::ploadu<Packet>(sum_b) - f_xy[l]);
-      sum_a[2] += f_z[l];
-      sum_b[2] -= f_z[l];
+      addToColumn(sum, a[l], f_xy[l], f_z[l]);
+      subtractFromColumn(sum, b[l], f_xy[l], f_z[l]);
     }
   }
   for (; k < count; ++k)

@@ -133,14 +133,8 @@ void projectDistancePair(const SweptRow* rows, const RowCoefficients* table, con
     lambda[l] += lanes[0][l];
     const double move_a = inverse_mass[a[l]] * lanes[0][l];
     const double move_b = inverse_mass[b[l]] * lanes[0][l];
-    double* const column_a = position + 3 * a[l];
-    double* const column_b = position + 3 * b[l];
-    const Packet step_a = Eigen::internal::pset1<Packet>(move_a) * u_xy[l];
-    const Packet step_b = Eigen::internal::pset1<Packet>(move_b) * u_xy[l];
-    Eigen::internal::pstoreu(column_a, ploadu<Packet>(column_a) + step_a);
-    Eigen::internal::pstoreu(column_b, ploadu<Packet>(column_b) - step_b);
-    column_a[2] += move_a * lanes[1][l];
-    column_b[2] -= move_b * lanes[1][l];
+    addToColumn(position, a[l], Eigen::internal::pset1<Packet>(move_a) * u_xy[l], move_a * lanes[1][l]);
+    subtractFromColumn(position, b[l], Eigen::internal::pset1<Packet>(move_b) * u_xy[l], move_b * lanes[1][l]);
   }
 }
 
@@ -216,12 +210,8 @@ SOFT_BODY_SIM_WIDE void applyQuadMove(const QuadMove& move, const Eigen::VectorX
     lambda[l] += delta_lambda;
     const double move_a = inverse_mass[move.a[l]] * delta_lambda;
     const double move_b = inverse_mass[move.b[l]] * delta_lambda;
-    double* const column_a = position + 3 * move.a[l];
-    double* const column_b = position + 3 * move.b[l];
-    _mm_storeu_pd(column_a, _mm_loadu_pd(column_a) + _mm_set1_pd(move_a) * move.u_xy[l]);
-    _mm_storeu_pd(column_b, _mm_loadu_pd(column_b) - _mm_set1_pd(move_b) * move.u_xy[l]);
-    column_a[2] += move_a * move.lanes[1][l];
-    column_b[2] -= move_b * move.lanes[1][l];
+    addToColumn(position, move.a[l], _mm_set1_pd(move_a) * move.u_xy[l], move_a * move.lanes[1][l]);
+    subtractFromColumn(position, move.b[l], _mm_set1_pd(move_b) * move.u_xy[l], move_b * move.lanes[1][l]);
   }
 }
 
