@@ -86,27 +86,46 @@ std::int32_t BallGrid::coordinate(double position) const
   return static_cast<std::int32_t>(std::clamp(std::floor(position / cell_), -1e9, 1e9));
 }
 
+std::uint64_t BallGrid::hashTerm(std::int64_t i, int axis)
+{
+  static constexpr std::uint64_t kPrimes[3] = { 73856093u, 19349663u, 83492791u };
+  return static_cast<std::uint64_t>(i) * kPrimes[axis];
+}
+
 std::int64_t BallGrid::slot(std::int64_t i, std::int64_t j, std::int64_t k) const
 {
-  const std::uint64_t hash = (static_cast<std::uint64_t>(i) * 73856093u) ^ (static_cast<std::uint64_t>(j) * 19349663u) ^
-                             (static_cast<std::uint64_t>(k) * 83492791u);
+  const std::uint64_t hash = hashTerm(i, 0) ^ hashTerm(j, 1) ^ hashTerm(k, 2);
   return static_cast<std::int64_t>(hash & (start_.size() - 2));  // the slot count is a power of two
 }
 
 int BallGrid::slotsAround(const std::int32_t* c, std::int64_t* slots) const
 {
+  // The hash's three terms for each axis's three cells, each worked out once; each slot once, though two
+  // cells may share one (marked with this query's number).
+  std::uint64_t term[3][3];
+  for (int axis = 0; axis < 3; ++axis)
+    for (int d = 0; d < 3; ++d)
+      term[axis][d] = hashTerm(static_cast<std::int64_t>(c[axis]) + d - 1, axis);
+  if (seen_.size() != start_.size() - 1 || ++query_ == 0)
+  {
+    seen_.assign(start_.size() - 1, 0u);
+    query_ = 1;
+  }
+  const std::uint64_t mask = start_.size() - 2;
   int count = 0;
-  for (int di = -1; di <= 1; ++di)
-    for (int dj = -1; dj <= 1; ++dj)
-      for (int dk = -1; dk <= 1; ++dk)
+  for (int di = 0; di < 3; ++di)
+    for (int dj = 0; dj < 3; ++dj)
+    {
+      const std::uint64_t ij = term[0][di] ^ term[1][dj];
+      for (int dk = 0; dk < 3; ++dk)
       {
-        const std::int64_t slot_index = slot(c[0] + di, c[1] + dj, c[2] + dk);
-        const std::size_t slot_u = static_cast<std::size_t>(slot_index);
-        if (start_[slot_u] == start_[slot_u + 1])
-          continue;  // empty: most of them, and nothing to tell apart
-        if (std::find(slots, slots + count, slot_index) == slots + count)
-          slots[count++] = slot_index;
+        const std::size_t slot_u = static_cast<std::size_t>((ij ^ term[2][dk]) & mask);
+        if (start_[slot_u] == start_[slot_u + 1] || seen_[slot_u] == query_)
+          continue;  // empty (most of them, and nothing to tell apart), or taken already
+        seen_[slot_u] = query_;
+        slots[count++] = static_cast<std::int64_t>(slot_u);
       }
+    }
   return count;
 }
 

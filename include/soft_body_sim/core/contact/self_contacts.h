@@ -45,6 +45,9 @@ public:
   }
 
 private:
+  /// Cell coordinate i's term of the hash along `axis` (Teschner et al.'s primes): a slot is the three's
+  /// exclusive or, masked to the slot count.
+  static std::uint64_t hashTerm(std::int64_t i, int axis);
   std::int64_t slot(std::int64_t i, std::int64_t j, std::int64_t k) const;
   std::int32_t coordinate(double position) const;
   /// The distinct non-empty slots of the 27 cells around (i, j, k) (two cells may share a slot); their count.
@@ -63,6 +66,9 @@ private:
   /// the balls in slot order: index, centre [m] and radius [m]
   std::vector<std::uint32_t> sorted_;
   std::vector<double> x_, y_, z_, r_;
+  /// per slot: the number of the last query (slotsAround) that took it; a query's own scratch
+  mutable std::vector<std::uint32_t> seen_;
+  mutable std::uint32_t query_ = 0;
 };
 
 template <typename Visit>
