@@ -92,40 +92,49 @@ std::uint64_t BallGrid::hashTerm(std::int64_t i, int axis)
   return static_cast<std::uint64_t>(i) * kPrimes[axis];
 }
 
-std::int64_t BallGrid::slot(std::int64_t i, std::int64_t j, std::int64_t k) const
+std::size_t BallGrid::slotOf(std::uint64_t terms) const
 {
-  const std::uint64_t hash = hashTerm(i, 0) ^ hashTerm(j, 1) ^ hashTerm(k, 2);
-  return static_cast<std::int64_t>(hash & (start_.size() - 2));  // the slot count is a power of two
+  // The terms' exclusive or has weak low bits (a flat cloth's cells fell into two thirds as many slots):
+  // its product with 2^64 / golden ratio, whose high bits mix all of them (Knuth's multiplicative hash).
+  return static_cast<std::size_t>((terms * 0x9E3779B97F4A7C15ull) >> shift_);
 }
 
-int BallGrid::slotsAround(const std::int32_t* c, std::int64_t* slots) const
+bool BallGrid::sameCell(std::uint32_t cell, const std::int32_t* c) const
 {
-  // The hash's three terms for each axis's three cells, each worked out once; each slot once, though two
-  // cells may share one (marked with this query's number).
+  const std::int32_t* key = &cell_key_[3 * static_cast<std::size_t>(cell)];
+  return key[0] == c[0] && key[1] == c[1] && key[2] == c[2];
+}
+
+int BallGrid::cellsAround(const std::int32_t* c, std::uint32_t* cells) const
+{
+  // The hash's three terms for each axis's three cells, each worked out once.
   std::uint64_t term[3][3];
   for (int axis = 0; axis < 3; ++axis)
     for (int d = 0; d < 3; ++d)
       term[axis][d] = hashTerm(static_cast<std::int64_t>(c[axis]) + d - 1, axis);
-  if (seen_.size() != start_.size() - 1 || ++query_ == 0)
-  {
-    seen_.assign(start_.size() - 1, 0u);
-    query_ = 1;
-  }
-  const std::uint64_t mask = start_.size() - 2;
+  const std::size_t mask = table_.size() - 1;
   int count = 0;
+  std::int32_t around[3];
   for (int di = 0; di < 3; ++di)
     for (int dj = 0; dj < 3; ++dj)
-    {
-      const std::uint64_t ij = term[0][di] ^ term[1][dj];
       for (int dk = 0; dk < 3; ++dk)
       {
-        const std::size_t slot_u = static_cast<std::size_t>((ij ^ term[2][dk]) & mask);
-        if (start_[slot_u] == start_[slot_u + 1] || seen_[slot_u] == query_)
-          continue;  // empty (most of them, and nothing to tell apart), or taken already
-        seen_[slot_u] = query_;
-        slots[count++] = static_cast<std::int64_t>(slot_u);
+        around[0] = c[0] + di - 1;
+        around[1] = c[1] + dj - 1;
+        around[2] = c[2] + dk - 1;
+        // Linear probing: the cell's entry, or an empty one where it would be (most of them).
+        for (std::size_t slot = slotOf(term[0][di] ^ term[1][dj] ^ term[2][dk]);; slot = (slot + 1) & mask)
+        {
+          const std::uint32_t cell = table_[slot];
+          if (cell == kEmpty)
+            break;
+          if (sameCell(cell, around))
+          {
+            cells[count++] = cell;
+            break;
+          }
+        }
       }
-    }
   return count;
 }
 
@@ -133,32 +142,52 @@ void BallGrid::build(const NodeArray& centre, const std::vector<double>& radius,
 {
   cell_ = cell;
   const std::size_t count = radius.size();
-  std::size_t slots = 1;  // a power of two, at least twice the balls: a mask, not a division, per lookup
+  std::size_t slots = 2;  // a power of two, at least twice the balls: a mask, not a division, per probe
+  shift_ = 63;
   while (slots < 2 * count)
+  {
     slots *= 2;
+    --shift_;
+  }
   coordinate_.resize(3 * count);
-  slot_of_.resize(count);
+  cell_of_.resize(count);
   place_.resize(count);
   sorted_.resize(count);
   x_.resize(count);
   y_.resize(count);
   z_.resize(count);
   r_.resize(count);
-  start_.assign(slots + 1, 0);
+  table_.assign(slots, kEmpty);
+  cell_key_.reserve(3 * count);  // at most a cell a ball: no allocation once grown to the ball count
+  cell_key_.clear();
+  const std::size_t mask = slots - 1;
   for (std::size_t s = 0; s < count; ++s)
   {
+    std::int32_t* c = &coordinate_[3 * s];
     for (int axis = 0; axis < 3; ++axis)
-      coordinate_[3 * s + static_cast<std::size_t>(axis)] = coordinate(centre(axis, static_cast<Eigen::Index>(s)));
-    const std::int32_t* c = &coordinate_[3 * s];
-    slot_of_[s] = static_cast<std::uint32_t>(slot(c[0], c[1], c[2]));
-    ++start_[slot_of_[s] + 1];
+      c[axis] = coordinate(centre(axis, static_cast<Eigen::Index>(s)));
+    std::size_t slot = slotOf(hashTerm(c[0], 0) ^ hashTerm(c[1], 1) ^ hashTerm(c[2], 2));
+    while (table_[slot] != kEmpty && !sameCell(table_[slot], c))
+      slot = (slot + 1) & mask;
+    if (table_[slot] == kEmpty)
+    {
+      table_[slot] = static_cast<std::uint32_t>(cell_key_.size() / 3);
+      cell_key_.insert(cell_key_.end(), c, c + 3);
+    }
+    cell_of_[s] = table_[slot];
   }
-  for (std::size_t q = 0; q < slots; ++q)
+  const std::size_t cells = cell_key_.size() / 3;
+  start_.reserve(count + 1);
+  start_.assign(cells + 1, 0);
+  for (std::size_t s = 0; s < count; ++s)
+    ++start_[cell_of_[s] + 1];
+  for (std::size_t q = 0; q < cells; ++q)
     start_[q + 1] += start_[q];
+  cursor_.reserve(count);
   cursor_.assign(start_.begin(), start_.end() - 1);
   for (std::size_t s = 0; s < count; ++s)
   {
-    const std::uint32_t e = cursor_[slot_of_[s]]++;
+    const std::uint32_t e = cursor_[cell_of_[s]]++;
     place_[s] = e;
     sorted_[e] = static_cast<std::uint32_t>(s);
     x_[e] = centre(0, static_cast<Eigen::Index>(s));

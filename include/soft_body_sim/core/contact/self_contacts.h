@@ -20,8 +20,10 @@ namespace soft_body_sim
 /// for Collision Detection of Deformable Objects"), over balls: a segment's midpoint and half length, a
 /// face's centroid and its farthest corner from it. With cells at least as wide as the two largest radii
 /// and the widest gap asked about, two balls within that gap of each other sit in the same or neighbouring
-/// cells. Built by a counting sort each time, the balls copied in the cells' order so that a cell's are
-/// read one after the other: no allocation once its arrays have grown to the ball count.
+/// cells. The cells that hold balls are numbered and found by their coordinates in a hash table, so that
+/// a query reads its 27 cells' balls and no others. Built by a counting sort each time, the balls copied
+/// in the cells' order so that a cell's are read one after the other: no allocation once its arrays have
+/// grown to the ball count.
 class BallGrid
 {
 public:
@@ -41,51 +43,56 @@ public:
 
   void carry(StateArchive& archive)
   {
-    archive(cell_, coordinate_, start_, slot_of_, cursor_, place_, sorted_, x_, y_, z_, r_);
+    archive(cell_, shift_, coordinate_, table_, cell_key_, start_, cell_of_, cursor_, place_, sorted_, x_, y_, z_, r_);
   }
 
 private:
-  /// Cell coordinate i's term of the hash along `axis` (Teschner et al.'s primes): a slot is the three's
-  /// exclusive or, masked to the slot count.
+  /// Cell coordinate i's term of the hash along `axis` (Teschner et al.'s primes): a cell's slot is made
+  /// from the three's exclusive or (slotOf).
   static std::uint64_t hashTerm(std::int64_t i, int axis);
-  std::int64_t slot(std::int64_t i, std::int64_t j, std::int64_t k) const;
+  /// The table's slot where a cell of these terms is looked for first.
+  std::size_t slotOf(std::uint64_t terms) const;
+  /// True if the cell numbered `cell` is the one at coordinates c.
+  bool sameCell(std::uint32_t cell, const std::int32_t* c) const;
   std::int32_t coordinate(double position) const;
-  /// The distinct non-empty slots of the 27 cells around (i, j, k) (two cells may share a slot); their count.
-  int slotsAround(const std::int32_t* c, std::int64_t* slots) const;
-  /// Calls visit(t) for every ball t of the slots around `c` closer than `gap` to the ball (p, r) with
+  /// The numbers of the balls' cells among the 27 around (i, j, k), each once; their count.
+  int cellsAround(const std::int32_t* c, std::uint32_t* cells) const;
+  /// Calls visit(t) for every ball t of the cells around `c` closer than `gap` to the ball (p, r) with
   /// t > after (after = -1: all).
   template <typename Visit>
   void visitAround(const std::int32_t* c, const Vec3& p, double r, double gap, std::int64_t after, Visit visit) const;
 
+  static constexpr std::uint32_t kEmpty = 0xffffffffu;
   double cell_ = 1.0;                     ///< [m]
+  int shift_ = 63;                        ///< 64 less the bits of the table's size
   std::vector<std::int32_t> coordinate_;  ///< per ball: its cell's i, j, k
-  std::vector<std::uint32_t> start_;      ///< per slot: where its balls begin in the sorted arrays
-  std::vector<std::uint32_t> slot_of_;    ///< per ball: its slot
-  std::vector<std::uint32_t> cursor_;     ///< per slot: the next free place while sorting
-  std::vector<std::uint32_t> place_;      ///< per ball: its place in the sorted arrays
-  /// the balls in slot order: index, centre [m] and radius [m]
+  /// A hash table with linear probing, at most half full: per slot, the number of a cell that has balls,
+  /// or kEmpty. Only a cell's own balls are read, not those of cells that share its hash.
+  std::vector<std::uint32_t> table_;
+  std::vector<std::int32_t> cell_key_;  ///< per cell: its i, j, k
+  std::vector<std::uint32_t> start_;    ///< per cell: where its balls begin in the sorted arrays
+  std::vector<std::uint32_t> cell_of_;  ///< per ball: its cell's number
+  std::vector<std::uint32_t> cursor_;   ///< per cell: the next free place while sorting
+  std::vector<std::uint32_t> place_;    ///< per ball: its place in the sorted arrays
+  /// the balls in cell order: index, centre [m] and radius [m]
   std::vector<std::uint32_t> sorted_;
   std::vector<double> x_, y_, z_, r_;
-  /// per slot: the number of the last query (slotsAround) that took it; a query's own scratch
-  mutable std::vector<std::uint32_t> seen_;
-  mutable std::uint32_t query_ = 0;
 };
 
 template <typename Visit>
 void BallGrid::visitAround(const std::int32_t* c, const Vec3& p, double r, double gap, std::int64_t after,
                            Visit visit) const
 {
-  std::int64_t slots[27];
-  const int count = slotsAround(c, slots);
+  std::uint32_t cells[27];
+  const int count = cellsAround(c, cells);
   for (int q = 0; q < count; ++q)
   {
-    const std::size_t slot_u = static_cast<std::size_t>(slots[q]);
-    // A slot's balls are in ascending order (build's counting sort): those after `after` are a tail.
-    const std::uint32_t* first = sorted_.data() + start_[slot_u];
-    const std::uint32_t* last = sorted_.data() + start_[slot_u + 1];
+    // A cell's balls are in ascending order (build's counting sort): those after `after` are a tail.
+    const std::uint32_t* first = sorted_.data() + start_[cells[q]];
+    const std::uint32_t* last = sorted_.data() + start_[cells[q] + 1];
     if (after >= 0)
       first = std::upper_bound(first, last, static_cast<std::uint32_t>(after));
-    for (std::size_t e = static_cast<std::size_t>(first - sorted_.data()); e < start_[slot_u + 1]; ++e)
+    for (std::size_t e = static_cast<std::size_t>(first - sorted_.data()); e < start_[cells[q] + 1]; ++e)
     {
       const double reach = r + r_[e] + gap;
       const double dx = x_[e] - p.x(), dy = y_[e] - p.y(), dz = z_[e] - p.z();
@@ -98,8 +105,8 @@ void BallGrid::visitAround(const std::int32_t* c, const Vec3& p, double r, doubl
 template <typename Visit>
 void BallGrid::forEachNearPair(double gap, Visit visit) const
 {
-  const std::size_t count = slot_of_.size();
-  // The balls in their own order (s ascending), each read from the sorted arrays through its slot.
+  const std::size_t count = cell_of_.size();
+  // The balls in their own order (s ascending), each read from the sorted arrays through its place.
   for (std::size_t s = 0; s < count; ++s)
   {
     const std::uint32_t e = place_[s];
