@@ -57,10 +57,11 @@ private:
   std::int32_t coordinate(double position) const;
   /// The numbers of the balls' cells among the 27 around (i, j, k), each once; their count.
   int cellsAround(const std::int32_t* c, std::uint32_t* cells) const;
-  /// Calls visit(t) for every ball t of the cells around `c` closer than `gap` to the ball (p, r) with
-  /// t > after (after = -1: all).
+  /// Calls visit(t) for every ball t of the `count` cells (cellsAround's) closer than `gap` to the ball
+  /// (p, r) with t > after (after = -1: all).
   template <typename Visit>
-  void visitAround(const std::int32_t* c, const Vec3& p, double r, double gap, std::int64_t after, Visit visit) const;
+  void visitCells(const std::uint32_t* cells, int count, const Vec3& p, double r, double gap, std::int64_t after,
+                  Visit visit) const;
 
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
   double cell_ = 1.0;                     ///< [m]
@@ -80,11 +81,9 @@ private:
 };
 
 template <typename Visit>
-void BallGrid::visitAround(const std::int32_t* c, const Vec3& p, double r, double gap, std::int64_t after,
-                           Visit visit) const
+void BallGrid::visitCells(const std::uint32_t* cells, int count, const Vec3& p, double r, double gap,
+                          std::int64_t after, Visit visit) const
 {
-  std::uint32_t cells[27];
-  const int count = cellsAround(c, cells);
   for (int q = 0; q < count; ++q)
   {
     // A cell's balls are in ascending order (build's counting sort): those after `after` are a tail.
@@ -106,12 +105,18 @@ template <typename Visit>
 void BallGrid::forEachNearPair(double gap, Visit visit) const
 {
   const std::size_t count = cell_of_.size();
-  // The balls in their own order (s ascending), each read from the sorted arrays through its place.
+  // The balls in their own order (s ascending), each read from the sorted arrays through its place; the
+  // cells around a ball looked up unless its predecessor's cell was the same (a rope's or a cloth row's
+  // next node, often).
+  std::uint32_t cells[27];
+  int around = 0;
   for (std::size_t s = 0; s < count; ++s)
   {
+    if (s == 0 || cell_of_[s] != cell_of_[s - 1])
+      around = cellsAround(&coordinate_[3 * s], cells);
     const std::uint32_t e = place_[s];
-    visitAround(&coordinate_[3 * s], Vec3(x_[e], y_[e], z_[e]), r_[e], gap, static_cast<std::int64_t>(s),
-                [&](std::size_t t) { visit(s, t); });
+    visitCells(cells, around, Vec3(x_[e], y_[e], z_[e]), r_[e], gap, static_cast<std::int64_t>(s),
+               [&](std::size_t t) { visit(s, t); });
   }
 }
 
@@ -119,7 +124,8 @@ template <typename Visit>
 void BallGrid::forEachNear(const Vec3& centre, double radius, double gap, Visit visit) const
 {
   const std::int32_t c[3] = { coordinate(centre.x()), coordinate(centre.y()), coordinate(centre.z()) };
-  visitAround(c, centre, radius, gap, -1, visit);
+  std::uint32_t cells[27];
+  visitCells(cells, cellsAround(c, cells), centre, radius, gap, -1, visit);
 }
 
 /// Segment-against-segment contact of the bodies with `self_collision` (BodyRange); a body without links
@@ -155,8 +161,8 @@ public:
   std::size_t searches() const { return searches_; }
 
   /// Writes or reads the Verlet lists and what the passes keep from sub-step to sub-step
-  /// (state_archive.h); the links, faces and their radii are the scene's, and travel_, entry_, near_index_
-  /// and candidate_bound_ are each resolve's own, written before it reads them.
+  /// (state_archive.h); the links, faces and their radii are the scene's, and travel_, entry_, near_index_,
+  /// candidate_bound_ and live_ are each resolve's own, written before it reads them.
   void carry(StateArchive& archive)
   {
     archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, tick_,
@@ -199,8 +205,8 @@ private:
   /// True if segments s and t end on a common node (neighbours along a rope, a cloth's edges at a corner).
   bool shareANode(std::size_t s, std::size_t t) const;
 
-  /// A face-contact cloth's pairs of edges near each other at rest (their contact within twice their
-  /// radii there: neighbours its springs hold apart), into rest_near_.
+  /// The pairs of one body that its springs hold apart, their contact at rest within twice their radii:
+  /// a cloth's or jelly's nodes (balls) and a face-contact cloth's edges, into rest_near_.
   void findRestNeighbours();
   /// The node-face pairs within the radii and the skin (each of nodes_ against faces_ through face_grid_).
   void findFaceCandidates(const NodeArray& x);
@@ -236,9 +242,9 @@ private:
   NodeArray middle_;                           ///< per segment: its midpoint when candidates are found [m]
   std::vector<double> half_;                   ///< per segment: half its length then [m]
   BallGrid grid_;
-  /// Per segment s, the later segments t (s < t) of its face-contact cloth near it at rest, which it never
-  /// collides with (findRestNeighbours): rest_near_[rest_near_start_[s] .. rest_near_start_[s + 1]); none
-  /// without face-contact cloths.
+  /// Per segment s, the later segments t (s < t) of its body near it at rest, which it never collides with
+  /// (findRestNeighbours): rest_near_[rest_near_start_[s] .. rest_near_start_[s + 1]); none without balls
+  /// or face-contact cloths.
   std::vector<std::uint32_t> rest_near_start_, rest_near_;
   /// per segment: 1 while the search looks at the pairs of a segment it is near at rest (a flag a pair
   /// reads at once, in place of looking through the list)
@@ -290,6 +296,8 @@ private:
   static constexpr std::int32_t kFar = -2, kUnknown = -1;
   /// per candidate: at most its links' least distance at the sub-step's start [m]
   std::vector<double> candidate_bound_;
+  /// the candidates not found far at this call's start (kUnknown), in order: those the passes look at
+  std::vector<std::uint32_t> live_;
   /// per node (global index): the tick_ of the last push that moved it
   std::vector<std::uint64_t> moved_at_;
   /// per node (global index): how far the passes of this resolve have moved it, summed [m] (from 0 for the
