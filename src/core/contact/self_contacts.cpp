@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <tuple>
 
@@ -297,15 +298,23 @@ bool SelfContacts::candidatesHold(const NodeArray& x)
     return false;
   // Two links come closer by at most |d_i - c| + |d_j - c| for their nodes' displacements d_i, d_j since
   // the candidates were found and any common c, since moving everything by c changes no distance. With c
-  // the mean displacement, a body that falls or is carried as a whole keeps its list.
-  Vec3 mean = Vec3::Zero();
+  // the middle of the displacements' bounding box, a body that falls or is carried as a whole keeps its
+  // list, and one that lands keeps it longer than with their mean: a cloth whose middle lies on a ball
+  // while its sides fall on is nearly all still and the farthest node is as far from the mean as from the
+  // still ones, but half as far from the box's middle (ClothOnSphere/self_collision: 155 searches in its
+  // first second with the mean, 137 with the box).
+  Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity()), high = -low;
   for (const int node : nodes_)
-    mean += x.col(node) - found_at_.col(node);
-  mean /= static_cast<double>(nodes_.size());
+  {
+    const Vec3 displacement = x.col(node) - found_at_.col(node);
+    low = low.cwiseMin(displacement);
+    high = high.cwiseMax(displacement);
+  }
+  const Vec3 middle = 0.5 * (low + high);
   const double limit = 0.25 * skin_ * skin_;
   for (const int node : nodes_)
   {
-    const double moved2 = (x.col(node) - found_at_.col(node) - mean).squaredNorm();
+    const double moved2 = (x.col(node) - found_at_.col(node) - middle).squaredNorm();
     if (moved2 > limit)
       return false;
     moved_[static_cast<std::size_t>(node)] = std::sqrt(moved2);
@@ -528,7 +537,7 @@ bool SelfContacts::resolve(const Model& model, State& state)
     const std::uint32_t s = candidate.s, t = candidate.t;
     const double touching = near_radius_[s] + near_radius_[t];
     near_index_[i] = kFar;
-    // Their points have moved, relative to the mean motion (which changes no distance), no farther than
+    // Their points have moved, relative to a common motion (which changes no distance), no farther than
     // their farthest node: a pair whose least distance was more than that beyond the contact distance is
     // not near, without its nearest points (most of a flat cloth's candidates, found within the skin, every
     // sub-step until the list is found again).

@@ -84,19 +84,24 @@ template <typename Visit>
 void BallGrid::visitCells(const std::uint32_t* cells, int count, const Vec3& p, double r, double gap,
                           std::int64_t after, Visit visit) const
 {
+  // The arrays' starts held here: visit may write memory, which would have them read again for each ball.
+  const std::uint32_t* sorted = sorted_.data();
+  const double *x = x_.data(), *y = y_.data(), *z = z_.data(), *radius = r_.data();
   for (int q = 0; q < count; ++q)
   {
-    // A cell's balls are in ascending order (build's counting sort): those after `after` are a tail.
-    const std::uint32_t* first = sorted_.data() + start_[cells[q]];
-    const std::uint32_t* last = sorted_.data() + start_[cells[q] + 1];
+    // A cell's balls are in ascending order (build's counting sort): those after `after` are a tail, found
+    // by looking along the cell (a few balls) rather than by halving it.
+    std::size_t e = start_[cells[q]];
+    const std::size_t last = start_[cells[q] + 1];
     if (after >= 0)
-      first = std::upper_bound(first, last, static_cast<std::uint32_t>(after));
-    for (std::size_t e = static_cast<std::size_t>(first - sorted_.data()); e < start_[cells[q] + 1]; ++e)
+      while (e < last && sorted[e] <= static_cast<std::uint32_t>(after))
+        ++e;
+    for (; e < last; ++e)
     {
-      const double reach = r + r_[e] + gap;
-      const double dx = x_[e] - p.x(), dy = y_[e] - p.y(), dz = z_[e] - p.z();
+      const double reach = r + radius[e] + gap;
+      const double dx = x[e] - p.x(), dy = y[e] - p.y(), dz = z[e] - p.z();
       if (dx * dx + dy * dy + dz * dz < reach * reach)
-        visit(static_cast<std::size_t>(sorted_[e]));
+        visit(static_cast<std::size_t>(sorted[e]));
     }
   }
 }
@@ -188,13 +193,13 @@ public:
   static constexpr double kNearRadiiOfEdges = 1.0;
 
   /// The candidate pairs (those that may touch) are found with a margin, the skin, of this many largest
-  /// radii, and kept until some node has moved half the skin relative to their mean motion (a Verlet
+  /// radii, and kept until some node has moved half the skin relative to a common motion (a Verlet
   /// list, as in molecular dynamics): a pile at rest, or a cloth falling flat, is searched once, not
   /// every sub-step.
   static constexpr double kSkinRadii = 2.0;
 
 private:
-  /// True if no node of a colliding link has moved half the skin, relative to their mean motion, since
+  /// True if no node of a colliding link has moved half the skin, relative to a common motion, since
   /// the candidates were found; each node's distance so moved into moved_.
   bool candidatesHold(const NodeArray& x);
   /// The pairs within their near radii (kNearRadiiOfLinks) and the skin, through the spatial hash.
@@ -262,7 +267,7 @@ private:
   std::vector<Candidate> candidates_;
   NodeArray found_at_;                         ///< positions when the candidates were found [m]
   /// per node (global index): how far it has moved since the candidates were found, relative to the
-  /// colliding nodes' mean motion [m] (candidatesHold)
+  /// colliding nodes' common motion (the middle of their displacements' bounding box) [m] (candidatesHold)
   std::vector<double> moved_;
   std::size_t searches_ = 0;
   /// Two links' contact at some positions: their nearest points' parameters p (on s) and q (on t), the
