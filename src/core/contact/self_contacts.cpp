@@ -639,7 +639,8 @@ bool SelfContacts::resolve(const Model& model, State& state)
            beyond(pair.contact.least - (travelled(pair.s, pair.t) - pair.travel), radius_[pair.s] + radius_[pair.t]);
   };
   // The passes take the candidates that may be near (live_, in the candidates' order): the others' passes
-  // change nothing (most of a folding cloth's: 33,000 candidates a search, about 500 of them near).
+  // change nothing (most of a folding cloth's: of 33,000 candidates a search, about 3,600 not found far at
+  // a sub-step's start and 500 near).
   for (int pass = 0; pass < kPasses; ++pass)
     for (const std::uint32_t i : live_)
     {
