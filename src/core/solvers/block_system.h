@@ -56,6 +56,7 @@ public:
   void analyze(int nodes, bool sparse_too)
   {
     nodes_ = nodes;
+    solid_sweeps_taken_ = 0.0;
     chains_ = mode_ != LinearSolve::Iterative && tridiagonal_solver_.analyze(nodes, pairs_);
     factorable_ = chains_ && !sparse_too;
     if (!factorable_)
@@ -92,6 +93,10 @@ public:
   /// A soft solid's estimate of the sweeps conjugate gradients take on it (the largest is kept): its
   /// sweeps grow with the mesh's size, not with its elements' stiffness over mass (TetrahedronKind).
   void noteSolidSweeps(double sweeps) { solid_sweeps_ = std::max(solid_sweeps_, sweeps); }
+  /// The sweeps conjugate gradients took in their last solve with soft solids since analyze (0: none), which
+  /// the choice of solve takes where more than the estimate; carried in snapshots, since it steers the
+  /// choice.
+  double& solidSweepsTaken() { return solid_sweeps_taken_; }
 
   /// dv = A^-1 rhs: directly, A written from the diagonal and `blocks` into the analysed pattern (block
   /// tridiagonal where the free nodes form chains and `chains_usable`, else sparse), or by conjugate
@@ -105,14 +110,17 @@ public:
       solveDirectly(blocks, tridiagonal_solver_, dv);
       return;
     }
+    const double solid_sweeps = solid_sweeps_ > 0.0 ? std::max(solid_sweeps_, solid_sweeps_taken_) : 0.0;
     const double cg_cost = std::max(kDirectWorkPerRootCondition * std::sqrt(condition_),
-                                    kDirectWorkPerSolidSweep * solid_sweeps_);
+                                    kDirectWorkPerSolidSweep * solid_sweeps);
     const bool cheaper_by_cg =
         mode_ == LinearSolve::Cheaper && sparse_solver_.factorWork() / sparse_solver_.matrixEntries() > cg_cost;
     if (!factorable_ || cheaper_by_cg)
     {
       buildPreconditioner(blocks);
-      solveIteratively(blocks, dv);
+      const double sweeps = static_cast<double>(solveIteratively(blocks, dv));
+      if (solid_sweeps_ > 0.0)
+        solid_sweeps_taken_ = sweeps;
       return;
     }
     solveDirectly(blocks, sparse_solver_, dv);
@@ -169,28 +177,31 @@ private:
   /// The residual takes the right-hand side's place (rhs_, which the next assembly makes anew), and the
   /// preconditioned residual z the product's (A direction, not needed once the residual is updated): two
   /// vectors where Eigen's takes four, 48 bytes a node.
+  /// Returns the sweeps it took.
   template <class Blocks>
-  void solveIteratively(const Blocks& blocks, NodeArray& dv)
+  Eigen::Index solveIteratively(const Blocks& blocks, NodeArray& dv)
   {
     const Eigen::Index n = rhs_.cols();
     dv.setZero(3, n);
     NodeArray& residual = rhs_;
     const double rhs_norm2 = rhs_.squaredNorm();
     if (rhs_norm2 == 0.0)
-      return;
+      return 0;
     const double threshold = std::max(kTolerance * kTolerance * rhs_norm2, std::numeric_limits<double>::min());
     double residual_norm2 = rhs_norm2;
     if (residual_norm2 < threshold)
-      return;  // rhs so small (near underflow) that any iteration would divide by zero
+      return 0;  // rhs so small (near underflow) that any iteration would divide by zero
     direction_.resize(3, n);
     product_.resize(3, n);
     NodeArray& z = product_;
     precondition(residual, direction_);
     double r_dot_z = dot(residual, direction_);
     const Eigen::Index max_iterations = 2 * 3 * n;
-    for (Eigen::Index iteration = 0; iteration < max_iterations; ++iteration)
+    Eigen::Index iteration = 0;
+    while (iteration < max_iterations)
     {
       multiply(blocks, direction_, product_);
+      ++iteration;
       const double alpha = r_dot_z / dot(direction_, product_);
       dv += alpha * direction_;
       residual -= alpha * product_;
@@ -202,6 +213,7 @@ private:
       r_dot_z = dot(residual, z);
       direction_ = z + (r_dot_z / previous_r_dot_z) * direction_;
     }
+    return iteration;
   }
 
   /// CG stops at a relative residual of 1e-12: far below the scheme's O(h) error; without it CG would
@@ -226,7 +238,11 @@ private:
   /// 72) and grow with the mesh (TetrahedronKind's estimate). Measured (bench_step BM_SoftBox direct and
   /// iterative, both steps, docs/RESULTS.md "Soft solids"): direct is faster at 3,127 tetrahedra (136
   /// multiply-adds per entry; CG took 239 sweeps at 1/60 s) and CG at 5,269 (266; 268 sweeps): the direct
-  /// path while its work per entry <= 0.7 of the estimated sweeps.
+  /// path while its work per entry <= 0.7 of the estimated sweeps. The estimate is the cube's: on a slender
+  /// or light solid CG takes more (a 30 cm cantilever 3 cm deep of 32,557 tetrahedra whose nodes weigh
+  /// next to nothing, test_volume: 1,300 to 1,500 sweeps where it estimated 479, and 495 multiply-adds per
+  /// entry), so the sweeps CG took in its last solve stand for the estimate where more (solidSweepsTaken):
+  /// one solve by CG, then the cheaper factorisation.
   static constexpr double kDirectWorkPerSolidSweep = 0.7;
   /// No factorisation is even prepared beyond this work per entry (a 100,000-node cloth would need
   /// 0.75 GB for its factor).
@@ -240,6 +256,7 @@ private:
   bool factorable_ = true;                  ///< the pattern is prepared for a direct solve (see kMaxFactorWork)
   double condition_ = 1.0;                  ///< estimate of block-Jacobi preconditioned A's condition number
   double solid_sweeps_ = 0.0;               ///< the soft solids' estimate of CG's sweeps (0: none)
+  double solid_sweeps_taken_ = 0.0;         ///< solidSweepsTaken
   NodeArray rhs_;
   std::vector<Matrix3> diagonal_;        ///< per node: its block of A (but the kinds' kept apart)
   std::vector<Matrix3> preconditioner_;  ///< per node: the inverse of A's full diagonal block (CG)

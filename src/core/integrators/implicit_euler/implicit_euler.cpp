@@ -58,8 +58,8 @@ public:
   std::unique_ptr<Integrator> clone() const override { return std::make_unique<ImplicitEuler>(*this); }
   bool assign(const Integrator& other) override { return assignIfSame(*this, other); }
   /// The pattern as it grew (the elements' pairs, then the holds' as they joined, which fix the
-  /// factorisation's order and so its round-off) and the holds; the analysis and the slots are made again
-  /// from them and the model.
+  /// factorisation's order and so its round-off), the holds and the sweeps CG took last (they steer the
+  /// choice of solve); the analysis and the slots are made again from them and the model.
   void carry(StateArchive& archive, const Model& model) override
   {
     ForceBasedIntegrator::carry(archive, model);
@@ -77,7 +77,7 @@ public:
       if (pairs.size() > element_pairs)
         system_.analyzeSparse();
     }
-    archive(collider_holds_, surface_holds_);
+    archive(collider_holds_, surface_holds_, system_.solidSweepsTaken());
   }
 
   void modelChanged() override { analyzed_ = false; }
