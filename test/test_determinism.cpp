@@ -105,6 +105,8 @@ const std::vector<Pinned> kPinned = {
   { "test/hard_cases/anchor_teleport.yaml", "rk4", 0xe57174c09f0aab4dULL },
   { "test/hard_cases/anchor_teleport.yaml", "implicit_euler", 0x7d88076d5ffd4ef3ULL },
   { "test/hard_cases/anchor_teleport.yaml", "xpbd", 0x95f85a7705aa2ce4ULL },
+  { "test/hard_cases/cloth_folds_on_ball.yaml", "implicit_euler", 0x2ac6c3ff1c83c316ULL },
+  { "test/hard_cases/cloth_folds_on_ball.yaml", "xpbd", 0x62d30cb74ef95a41ULL },
   { "test/hard_cases/damping_threshold.yaml", "implicit_euler", 0x82b2bfb8e1b93444ULL },
   { "test/hard_cases/damping_threshold.yaml", "xpbd", 0x4c9296c1d78a2d48ULL },
   { "test/hard_cases/heavy_end_chain.yaml", "implicit_euler", 0x2ca19ae4703e8c0bULL },
