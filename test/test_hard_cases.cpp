@@ -323,31 +323,6 @@ TEST(HardCase11Extremes, MassesFromMicrogramsToKilotonnesOnGigaNewtonSpringsStay
 
 // --- 12. self-colliding cloths folding over balls --------------------------------------------------------
 
-/// Whether segment pq crosses triangle abc (its interior or boundary).
-bool crossesTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c)
-{
-  const Vec3 n = (b - a).cross(c - a);
-  const double dp = n.dot(p - a), dq = n.dot(q - a);
-  if (dp * dq > 0.0 || dp == dq)
-    return false;
-  const Vec3 x = p + dp / (dp - dq) * (q - p);
-  return n.dot((b - a).cross(x - a)) >= 0.0 && n.dot((c - b).cross(x - b)) >= 0.0 && n.dot((a - c).cross(x - c)) >= 0.0;
-}
-
-/// The squares' two triangles of an n x n grid of nodes from `first`, split as buildCloth splits them.
-std::vector<std::array<int, 3>> gridTriangles(int first, int n)
-{
-  std::vector<std::array<int, 3>> triangles;
-  const auto node = [&](int i, int j) { return first + j * n + i; };
-  for (int j = 0; j + 1 < n; ++j)
-    for (int i = 0; i + 1 < n; ++i)
-    {
-      triangles.push_back({ node(i, j), node(i + 1, j), node(i + 1, j + 1) });
-      triangles.push_back({ node(i, j), node(i + 1, j + 1), node(i, j + 1) });
-    }
-  return triangles;
-}
-
 /// How many of the triangles' edges cross a triangle with which they share no node: zero while the
 /// surface does not pass through itself (brute force over every edge and triangle, boxes first).
 int selfCrossings(const NodeArray& x, const std::vector<std::array<int, 3>>& triangles)
@@ -404,7 +379,9 @@ TEST(HardCase12SelfCollision, ClothsFoldingOverBallsNeverPassThroughThemselves)
         for (int j = i + 1; j < n * n; ++j)
           if ((rest.col(i) - rest.col(j)).norm() > 2.0 * contact)
             apart.emplace_back(i, j);
-      const std::vector<std::array<int, 3>> faces = gridTriangles(n * n, n);
+      // The faces' cloth is the scene's only body that collides by triangles: its 19 x 19 squares' two each.
+      const std::vector<std::array<int, 3>>& faces = world.model().contact_triangles;
+      ASSERT_EQ(faces.size(), 2u * (n - 1) * (n - 1));
       double closest = 1e300;
       int most_crossings = 0;
       for (int step = 0; step < 120; ++step)

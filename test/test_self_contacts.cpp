@@ -870,17 +870,6 @@ TEST(SelfContacts, AThinClothWithFaceContactsFoldedOntoItselfKeepsItsLayersApart
 
 // --- a rope on a cloth trampoline (a cloth's faces and edges, face_contacts) -----------------------------
 
-/// Whether segment pq passes through triangle abc (its interior or boundary).
-bool crossesTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c)
-{
-  const Vec3 n = (b - a).cross(c - a);
-  const double dp = n.dot(p - a), dq = n.dot(q - a);
-  if (dp * dq > 0.0 || dp == dq)
-    return false;
-  const Vec3 x = p + dp / (dp - dq) * (q - p);
-  return n.dot((b - a).cross(x - a)) >= 0.0 && n.dot((c - b).cross(x - b)) >= 0.0 && n.dot((a - c).cross(x - c)) >= 0.0;
-}
-
 /// A 1 m trampoline, a cloth of 21 x 21 nodes (5 cm spacing, 5 mm thick) pinned all round its border at
 /// z = 1 m, with face_contacts and self_collision, and a 5 mm rope of 61 nodes (1 cm links), 0.6 m long,
 /// dropped from 5 cm above it along x at y = 0.025 m: midway between two node rows, where the cloth's

@@ -162,4 +162,15 @@ struct Oscillator
   }
 };
 
+/// Whether segment pq passes through triangle abc (its interior or boundary).
+inline bool crossesTriangle(const Vec3& p, const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  const Vec3 n = (b - a).cross(c - a);
+  const double dp = n.dot(p - a), dq = n.dot(q - a);
+  if (dp * dq > 0.0 || dp == dq)
+    return false;
+  const Vec3 x = p + dp / (dp - dq) * (q - p);
+  return n.dot((b - a).cross(x - a)) >= 0.0 && n.dot((c - b).cross(x - b)) >= 0.0 && n.dot((a - c).cross(x - c)) >= 0.0;
+}
+
 }  // namespace soft_body_sim::test
