@@ -53,7 +53,7 @@ const std::vector<Pinned> kPinned = {
   { "config/scenes/creature.yaml", "rk4", 0xd697d53e481029b5ULL },
   { "config/scenes/creature.yaml", "implicit_euler", 0xe7adc476ec781decULL },
   { "config/scenes/creature.yaml", "xpbd", 0x4cc3d2920fde0bf4ULL },
-  { "config/scenes/demo.yaml", "implicit_euler", 0x2fc03dbf2e507073ULL },
+  { "config/scenes/demo.yaml", "implicit_euler", 0xe542504378f0797eULL },
   { "config/scenes/demo.yaml", "xpbd", 0x2d9558da5e4ba8dcULL },
   { "config/scenes/hanging_chain.yaml", "implicit_euler", 0x114803029f29833cULL },
   { "config/scenes/hanging_chain.yaml", "xpbd", 0xa88ae03d24c4615eULL },

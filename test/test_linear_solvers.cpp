@@ -1,9 +1,10 @@
 // implicit_euler's linear solves. Its two direct solvers (SparseBlockSolver, BlockTridiagonalSolver)
 // against a dense reference: random symmetric positive definite systems of 3x3 blocks with the pattern
 // of a rope, a cloth (with shear and bending pairs) or chains, solved by Eigen's dense LDL^T of the same
-// matrix, and the same solver reused after new values (the pattern analysed once). Then the integrator's
-// direct and iterative paths on the same random states of a chain, a rope with bending springs and a
-// cloth: the same step to the conjugate gradients' tolerance.
+// matrix, and the same solver reused after new values (the pattern analysed once); the block-tridiagonal
+// solver also on the chains among other components, as conjugate gradients' preconditioner takes them. Then
+// the integrator's direct and iterative paths on the same random states of a chain, a rope with bending
+// springs, a cloth, and a rope beside a cloth: the same step to the conjugate gradients' tolerance.
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -194,6 +195,46 @@ TEST(BlockTridiagonalSolver, DeclinesBranchesAndCycles)
   EXPECT_THROW(solver.analyze(3, { { 1, 1 } }), std::invalid_argument);
 }
 
+// The chains among a pattern that is not all chains: only the components that are paths of two nodes or
+// more. A is block diagonal over its components, so the chains' part of its dense solution is the chains'
+// solve; the other nodes' columns of x are left as they were.
+TEST(BlockTridiagonalSolver, SolvesTheChainsAmongOtherComponentsAndLeavesTheOtherNodes)
+{
+  const std::vector<std::pair<int, int>> pairs = {
+    { 0, 1 }, { 1, 2 }, { 3, 2 }, { 3, 4 }, { 4, 5 },  // a chain 0-5, one pair named the other way round
+    { 6, 7 }, { 6, 8 }, { 6, 9 },                      // a star: 6 has three neighbours
+    { 10, 11 }, { 11, 12 }, { 12, 10 },                // a triangle
+    { 14, 15 }, { 15, 16 }, { 16, 17 }, { 16, 18 },    // a chain that ends in a branch (16)
+    { 19, 20 }, { 20, 19 },                            // a chain of two, its pair given twice
+  };                                                   // 13 alone
+  constexpr int nodes = 21;
+  const std::vector<int> on_chains = { 0, 1, 2, 3, 4, 5, 19, 20 };
+  BlockTridiagonalSolver solver;
+  ASSERT_TRUE(solver.analyzeChains(nodes, pairs));
+  for (int i = 0; i < nodes; ++i)
+    EXPECT_EQ(solver.onPath(i), std::count(on_chains.begin(), on_chains.end(), i) == 1) << "node " << i;
+  std::mt19937 random(5);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  Eigen::MatrixXd dense;
+  fillRandom(random, nodes, pairs, solver, dense);
+  NodeArray rhs(3, nodes);
+  for (int i = 0; i < nodes; ++i)
+    rhs.col(i) = Vec3(value(random), value(random), value(random));
+  ASSERT_TRUE(solver.factorize());
+  NodeArray x = NodeArray::Constant(3, nodes, 7.0);
+  solver.solve(rhs, x);
+  const Eigen::VectorXd reference = dense.ldlt().solve(Eigen::Map<const Eigen::VectorXd>(rhs.data(), 3 * nodes));
+  for (int i = 0; i < nodes; ++i)
+    if (solver.onPath(i))
+      EXPECT_LT((x.col(i) - reference.segment<3>(3 * i)).norm(), 1e-10 * reference.norm()) << "node " << i;
+    else
+      EXPECT_EQ(x.col(i), Vec3::Constant(7.0)) << "node " << i;
+  // No chain of two nodes or more: nothing to solve.
+  EXPECT_FALSE(solver.analyzeChains(100, clothPairs(10, 10)));
+  EXPECT_FALSE(solver.analyzeChains(3, { { 0, 1 }, { 1, 2 }, { 2, 0 } }));
+  EXPECT_FALSE(solver.analyzeChains(2, {}));
+}
+
 TEST(BlockTridiagonalSolver, RefusesAMatrixThatIsNotPositiveDefinite)
 {
   BlockTridiagonalSolver solver;
@@ -258,17 +299,19 @@ double conditionBound(const Model& model, double h)
   return largest / smallest;
 }
 
-/// From random states of `body` (every free node moved by up to 0.3 of `spacing` [m] in each axis, so
+/// From random states of `bodies` (every free node moved by up to 0.3 of `spacing` [m] in each axis, so
 /// that springs are both stretched and compressed, and given a random velocity of up to 1 m/s), one
-/// implicit Euler step of 1/60 s solved directly and one solved by conjugate gradients. CG stops at a
-/// relative residual of 1e-12, so its velocity change differs from the exact one by at most
-/// condition(A) 1e-12 relative; the direct solve's rounding error (condition times 1e-16) is far below.
-void expectDirectAndIterativeAgree(const BodyDef& body, double spacing)
+/// implicit Euler step of 1/60 s solved directly and one solved by conjugate gradients (`iterative`:
+/// LinearSolve::Iterative, or Cheaper where the rule takes them). CG stops at a relative residual of
+/// 1e-12, so its velocity change differs from the exact one by at most condition(A) 1e-12 relative; the
+/// direct solve's rounding error (condition times 1e-16) is far below.
+void expectDirectAndIterativeAgree(const std::vector<BodyDef>& bodies, double spacing,
+                                   LinearSolve iterative_solve = LinearSolve::Iterative)
 {
-  SCOPED_TRACE(body.name);
+  SCOPED_TRACE(bodies.front().name);
   SceneDef scene;
   scene.physics.integrator = IntegratorType::ImplicitEuler;
-  scene.bodies.push_back(body);
+  scene.bodies = bodies;
   const World world = buildWorld(scene);
   const Model& model = world.model();
   constexpr double h = 1.0 / 60.0;
@@ -287,7 +330,7 @@ void expectDirectAndIterativeAgree(const BodyDef& body, double spacing)
       }
     State direct = start, iterative = start;
     makeImplicitEuler(LinearSolve::Direct)->step(model, direct, h, 1);
-    makeImplicitEuler(LinearSolve::Iterative)->step(model, iterative, h, 1);
+    makeImplicitEuler(iterative_solve)->step(model, iterative, h, 1);
     const double change = (direct.velocity - start.velocity).norm();
     ASSERT_GT(change, 0.0);
     EXPECT_LT((direct.velocity - iterative.velocity).norm(), condition * 1e-12 * change)
@@ -303,10 +346,10 @@ TEST(ImplicitEulerLinearSolve, DirectAndIterativePathsGiveTheSameStep)
   chain.stiffness = 1000.0;
   chain.damping = 0.05;
   chain.pinned = { 0 };
-  expectDirectAndIterativeAgree(buildRope("chain", chain), 1.0 / 39.0);
+  expectDirectAndIterativeAgree({ buildRope("chain", chain) }, 1.0 / 39.0);
   RopeDef rope = chain;  // with bending springs: the sparse factorisation
   rope.bending = 100.0;
-  expectDirectAndIterativeAgree(buildRope("rope with bending", rope), 1.0 / 39.0);
+  expectDirectAndIterativeAgree({ buildRope("rope with bending", rope) }, 1.0 / 39.0);
   ClothDef cloth;  // 10 x 8 nodes of 1 g
   cloth.nx = 10;
   cloth.ny = 8;
@@ -315,7 +358,32 @@ TEST(ImplicitEulerLinearSolve, DirectAndIterativePathsGiveTheSameStep)
   cloth.shear = SpringParameters{ 50.0, 0.01 };
   cloth.bending = SpringParameters{ 10.0, 0.0 };
   cloth.pinned = { 0, 9 };
-  expectDirectAndIterativeAgree(buildCloth("cloth", cloth), 1.0 / 9.0);
+  expectDirectAndIterativeAgree({ buildCloth("cloth", cloth) }, 1.0 / 9.0);
+}
+
+// A cloth large enough that the rule takes conjugate gradients (32 x 32 nodes at 1/60 s), beside a stiff
+// chain, which their preconditioner solves exactly (BlockSystem, chain_preconditioner_): the step the
+// factorisation gives.
+TEST(ImplicitEulerLinearSolve, ConjugateGradientsWithTheChainsSolvedInThePreconditionerGiveTheDirectStep)
+{
+  ClothDef cloth;
+  cloth.nx = 32;
+  cloth.ny = 32;
+  cloth.mass = 0.5;
+  cloth.structural = SpringParameters{ 100.0, 0.02 };
+  cloth.shear = SpringParameters{ 50.0, 0.01 };
+  cloth.bending = SpringParameters{ 10.0, 0.0 };
+  cloth.pinned = { 0, 31 };
+  RopeDef chain;  // 60 nodes of 1 g on 1 cm links of 1e4 N/m, away from the cloth
+  chain.nodes = 60;
+  chain.from = Vec3(0.0, 0.0, 2.0);
+  chain.to = Vec3(0.59, 0.0, 2.0);
+  chain.mass = 0.06;
+  chain.stiffness = 1e4;
+  chain.damping = 0.05;
+  chain.pinned = { 0 };
+  expectDirectAndIterativeAgree({ buildCloth("cloth beside a chain", cloth), buildRope("chain", chain) }, 1.0 / 31.0,
+                                LinearSolve::Cheaper);
 }
 
 }  // namespace

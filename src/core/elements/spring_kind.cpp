@@ -59,7 +59,7 @@ void SpringKind::ImplicitBlocks::assemble(const NewtonPoint& point, BlockSystem&
     // The preconditioned A's largest eigenvalue over its smallest is about 1 + 4 (h^2 k + h c) / m
     // for the stiffest spring on its lightest free end (a chain's: (m + 4 h^2 k) / m).
     const double lightest = std::max(model.inverse_mass[s.a], model.inverse_mass[s.b]);
-    system.noteCondition(1.0 + 4.0 * (h * h * s.stiffness + h * s.damping) * lightest);
+    system.noteCondition(1.0 + 4.0 * (h * h * s.stiffness + h * s.damping) * lightest, s.a, s.b);
     if (model.isFree(s.a))
     {
       rhs.col(s.a) += impulse;

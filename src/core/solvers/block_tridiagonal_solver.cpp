@@ -45,11 +45,12 @@ inline bool invertPositiveDefinite(const Eigen::Matrix3d& s, Eigen::Matrix3d& in
 }
 }  // namespace
 
-bool BlockTridiagonalSolver::analyze(int nodes, const std::vector<std::pair<int, int>>& pairs)
+bool BlockTridiagonalSolver::analyzePaths(int nodes, const std::vector<std::pair<int, int>>& pairs, bool chains_only)
 {
   const std::size_t n = static_cast<std::size_t>(nodes);
-  // Each node's distinct neighbours (at most two on a path).
+  // Each node's distinct neighbours (at most two on a path); a node with a third is a branch.
   std::vector<std::array<int, 2>> neighbours(n, { -1, -1 });
+  std::vector<char> branch(n, 0);
   for (const auto& [a, b] : pairs)
   {
     if (a == b || a < 0 || b < 0 || a >= nodes || b >= nodes)
@@ -60,23 +61,37 @@ bool BlockTridiagonalSolver::analyze(int nodes, const std::vector<std::pair<int,
       if (near[0] == to || near[1] == to)
         continue;  // the same pair again: its blocks add up in one place
       if (near[1] >= 0)
-        return false;  // a third neighbour: a branch
+      {
+        if (!chains_only)
+          return false;
+        branch[static_cast<std::size_t>(from)] = 1;
+        continue;
+      }
       near[near[0] < 0 ? 0 : 1] = to;
     }
   }
-  // Walk each path from one of its ends; nodes left over lie on cycles.
+  // Walk each path from one of its ends; nodes left over lie on cycles. With chains_only, a walk that meets
+  // a branch is undone (its component is no path: every node before the branch has its neighbours on the
+  // walk, so a walk that ends without meeting one has gone through its whole component), and so is a lone
+  // node (its diagonal block alone: the caller's).
   position_.assign(n, -1);
   order_.clear();
   order_.reserve(n);
   paths_.clear();
   for (std::size_t start = 0; start < n; ++start)
   {
-    if (position_[start] >= 0 || neighbours[start][1] >= 0)
+    if (position_[start] >= 0 || neighbours[start][1] >= 0 || branch[start] != 0)
       continue;
     const std::size_t begin = order_.size();
+    bool path = true;
     int previous = -1;
     for (int node = static_cast<int>(start); node >= 0;)
     {
+      if (branch[static_cast<std::size_t>(node)] != 0)
+      {
+        path = false;
+        break;
+      }
       position_[static_cast<std::size_t>(node)] = static_cast<int>(order_.size());
       order_.push_back(node);
       const std::array<int, 2>& near = neighbours[static_cast<std::size_t>(node)];
@@ -84,22 +99,30 @@ bool BlockTridiagonalSolver::analyze(int nodes, const std::vector<std::pair<int,
       previous = node;
       node = next;
     }
+    if (chains_only && (!path || order_.size() - begin < 2))
+    {
+      for (std::size_t k = begin; k < order_.size(); ++k)
+        position_[static_cast<std::size_t>(order_[k])] = -1;
+      order_.resize(begin);
+      continue;
+    }
     paths_.push_back(Path{ begin, begin + (order_.size() - begin) / 2, order_.size() });
   }
-  if (order_.size() != n)
+  if (!chains_only && order_.size() != n)
     return false;
   slot_.clear();
   slot_.reserve(pairs.size());
   for (const auto& [a, b] : pairs)
   {
     const int pa = position_[static_cast<std::size_t>(a)], pb = position_[static_cast<std::size_t>(b)];
-    slot_.push_back(Slot{ std::min(pa, pb), pa > pb });
+    slot_.push_back(pa < 0 ? Slot{ -1, false } : Slot{ std::min(pa, pb), pa > pb });
   }
-  diagonal_.resize(n);
-  upper_.resize(n);
-  inverse_.resize(n);
-  gain_.resize(n);
-  z_.resize(3, nodes);
+  const std::size_t places = order_.size();
+  diagonal_.resize(places);
+  upper_.resize(places);
+  inverse_.resize(places);
+  gain_.resize(places);
+  z_.resize(3, static_cast<Eigen::Index>(places));
   return true;
 }
 
@@ -149,7 +172,7 @@ bool BlockTridiagonalSolver::factorize()
 
 void BlockTridiagonalSolver::solve(const NodeArray& rhs, NodeArray& x)
 {
-  x.resize(3, static_cast<Eigen::Index>(order_.size()));
+  x.resize(3, rhs.cols());
   const auto z = [this](std::size_t k) { return z_.col(static_cast<Eigen::Index>(k)); };
   for (const Path& path : paths_)
   {

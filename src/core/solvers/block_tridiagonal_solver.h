@@ -38,16 +38,33 @@ public:
   /// pairs `pairs` (i != j; a pair may repeat). Slot k of addOffDiagonal is pairs[k]. True if the pairs
   /// form paths (then everything is prepared); false if a node is coupled to three or more others or
   /// the pairs close a cycle (nothing is kept: solve otherwise).
-  bool analyze(int nodes, const std::vector<std::pair<int, int>>& pairs);
+  bool analyze(int nodes, const std::vector<std::pair<int, int>>& pairs) { return analyzePaths(nodes, pairs, false); }
+  /// The chains among a pattern that is not all chains: its components (nodes joined through pairs) that are
+  /// paths of two nodes or more, each solved as analyze's; the other nodes and their pairs are left out
+  /// (addDiagonal and addOffDiagonal pass them over, solve leaves their columns of x as they were). True if
+  /// there is such a chain (implicit Euler's preconditioner in a scene of ropes and cloths, BlockSystem).
+  bool analyzeChains(int nodes, const std::vector<std::pair<int, int>>& pairs)
+  {
+    return analyzePaths(nodes, pairs, true) && !paths_.empty();
+  }
+  /// True if node i lies on one of the analysed paths.
+  bool onPath(int i) const { return position_[static_cast<std::size_t>(i)] >= 0; }
 
   /// Starts a new matrix (same pattern): A's diagonal block of node i = diagonal[i], every other block 0.
   void start(const std::vector<Matrix3>& diagonal);
   /// A's diagonal block of node i += block (symmetric).
-  void addDiagonal(int i, const Matrix3& block) { diagonal_[static_cast<std::size_t>(position_[static_cast<std::size_t>(i)])] += block; }
+  void addDiagonal(int i, const Matrix3& block)
+  {
+    const int place = position_[static_cast<std::size_t>(i)];
+    if (place >= 0)
+      diagonal_[static_cast<std::size_t>(place)] += block;
+  }
   /// A's block (a, b) += block, and (b, a) += block^T, for the pair (a, b) of slot `slot`.
   void addOffDiagonal(std::size_t slot, const Matrix3& block)
   {
     const Slot& s = slot_[slot];
+    if (s.link < 0)
+      return;  // a pair off the paths (analyzeChains)
     if (s.transposed)
       upper_[static_cast<std::size_t>(s.link)] += block.transpose();
     else
@@ -56,17 +73,21 @@ public:
 
   /// Factorises A; false if it is not positive definite to working precision.
   bool factorize();
-  /// x = A^-1 rhs (3 x nodes), after a successful factorize.
+  /// x = A^-1 rhs (3 x nodes), after a successful factorize: the columns of the nodes on the paths.
   void solve(const NodeArray& rhs, NodeArray& x);
 
 private:
   /// Where a slot's block goes: the link between path positions `link` and link + 1, stored as
-  /// A(order[link], order[link + 1]); transposed when the pair names them the other way round.
+  /// A(order[link], order[link + 1]); transposed when the pair names them the other way round; link -1 for
+  /// a pair off the paths.
   struct Slot
   {
     int link;
     bool transposed;
   };
+
+  /// analyze (every node on a path, else false) or, with `chains_only`, analyzeChains.
+  bool analyzePaths(int nodes, const std::vector<std::pair<int, int>>& pairs, bool chains_only);
 
   /// A path's places [begin, end) and its middle.
   struct Path
@@ -78,7 +99,7 @@ private:
   /// on the side of the middle (both at the middle); false if S_k is not SPD.
   bool pivot(std::size_t k, const Path& path);
 
-  std::vector<int> position_;      ///< per node: its place in the paths' order
+  std::vector<int> position_;      ///< per node: its place in the paths' order, -1 off them
   std::vector<int> order_;         ///< per place: the node
   std::vector<Path> paths_;
   std::vector<Slot> slot_;
