@@ -338,6 +338,21 @@ void expectDirectAndIterativeAgree(const std::vector<BodyDef>& bodies, double sp
   }
 }
 
+/// An nx x ny cloth of `mass` [kg] on soft springs (structural 100 N/m, shear 50, bending 10), hanging
+/// from its first row's two corners.
+ClothDef softCloth(int nx, int ny, double mass)
+{
+  ClothDef cloth;
+  cloth.nx = nx;
+  cloth.ny = ny;
+  cloth.mass = mass;
+  cloth.structural = SpringParameters{ 100.0, 0.02 };
+  cloth.shear = SpringParameters{ 50.0, 0.01 };
+  cloth.bending = SpringParameters{ 10.0, 0.0 };
+  cloth.pinned = { 0, nx - 1 };
+  return cloth;
+}
+
 TEST(ImplicitEulerLinearSolve, DirectAndIterativePathsGiveTheSameStep)
 {
   RopeDef chain;  // 40 nodes of 1 g on springs of 1000 N/m: block tridiagonal
@@ -350,15 +365,8 @@ TEST(ImplicitEulerLinearSolve, DirectAndIterativePathsGiveTheSameStep)
   RopeDef rope = chain;  // with bending springs: the sparse factorisation
   rope.bending = 100.0;
   expectDirectAndIterativeAgree({ buildRope("rope with bending", rope) }, 1.0 / 39.0);
-  ClothDef cloth;  // 10 x 8 nodes of 1 g
-  cloth.nx = 10;
-  cloth.ny = 8;
-  cloth.mass = 0.08;
-  cloth.structural = SpringParameters{ 100.0, 0.02 };
-  cloth.shear = SpringParameters{ 50.0, 0.01 };
-  cloth.bending = SpringParameters{ 10.0, 0.0 };
-  cloth.pinned = { 0, 9 };
-  expectDirectAndIterativeAgree({ buildCloth("cloth", cloth) }, 1.0 / 9.0);
+  // 10 x 8 nodes of 1 g
+  expectDirectAndIterativeAgree({ buildCloth("cloth", softCloth(10, 8, 0.08)) }, 1.0 / 9.0);
 }
 
 // A cloth large enough that the rule takes conjugate gradients (32 x 32 nodes at 1/60 s), beside a stiff
@@ -366,14 +374,6 @@ TEST(ImplicitEulerLinearSolve, DirectAndIterativePathsGiveTheSameStep)
 // factorisation gives.
 TEST(ImplicitEulerLinearSolve, ConjugateGradientsWithTheChainsSolvedInThePreconditionerGiveTheDirectStep)
 {
-  ClothDef cloth;
-  cloth.nx = 32;
-  cloth.ny = 32;
-  cloth.mass = 0.5;
-  cloth.structural = SpringParameters{ 100.0, 0.02 };
-  cloth.shear = SpringParameters{ 50.0, 0.01 };
-  cloth.bending = SpringParameters{ 10.0, 0.0 };
-  cloth.pinned = { 0, 31 };
   RopeDef chain;  // 60 nodes of 1 g on 1 cm links of 1e4 N/m, away from the cloth
   chain.nodes = 60;
   chain.from = Vec3(0.0, 0.0, 2.0);
@@ -382,8 +382,8 @@ TEST(ImplicitEulerLinearSolve, ConjugateGradientsWithTheChainsSolvedInThePrecond
   chain.stiffness = 1e4;
   chain.damping = 0.05;
   chain.pinned = { 0 };
-  expectDirectAndIterativeAgree({ buildCloth("cloth beside a chain", cloth), buildRope("chain", chain) }, 1.0 / 31.0,
-                                LinearSolve::Cheaper);
+  expectDirectAndIterativeAgree({ buildCloth("cloth beside a chain", softCloth(32, 32, 0.5)), buildRope("chain", chain) },
+                                1.0 / 31.0, LinearSolve::Cheaper);
 }
 
 }  // namespace

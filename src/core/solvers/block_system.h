@@ -61,8 +61,9 @@ public:
     solid_sweeps_taken_ = 0.0;
     chains_ = mode_ != LinearSolve::Iterative && tridiagonal_solver_.analyze(nodes, pairs_);
     factorable_ = chains_ && !sparse_too;
-    chain_preconditioner_ = false;
-    if (!factorable_)
+    if (factorable_)
+      keepChainPreconditioner(false);  // every solve is the direct one
+    else
       analyzeSparse();
   }
   /// Prepares the sparse solve again, for pairs added since analyze, and the chains of conjugate gradients'
@@ -71,9 +72,7 @@ public:
   {
     factorable_ = mode_ != LinearSolve::Iterative &&
                   sparse_solver_.analyze(nodes_, pairs_, mode_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork);
-    chain_preconditioner_ = mode_ == LinearSolve::Cheaper && chain_solver_.analyzeChains(nodes_, pairs_);
-    if (!chain_preconditioner_)
-      chain_solver_ = BlockTridiagonalSolver();  // its arrays freed: a cloth of 100,000 nodes has no chain
+    keepChainPreconditioner(mode_ == LinearSolve::Cheaper && chain_solver_.analyzeChains(nodes_, pairs_));
   }
   bool iterativeOnly() const { return mode_ == LinearSolve::Iterative; }
 
@@ -145,6 +144,15 @@ public:
   }
 
 private:
+  /// Whether conjugate gradients' preconditioner solves the chains (chain_preconditioner_); without, the
+  /// chains' solver's arrays are freed (a cloth of 100,000 nodes has no chain).
+  void keepChainPreconditioner(bool keep)
+  {
+    chain_preconditioner_ = keep;
+    if (!keep)
+      chain_solver_ = BlockTridiagonalSolver();
+  }
+
   /// Writes A into `solver` (analysed with the pattern's slots), factorises it and solves for dv.
   template <class Blocks, class Solver>
   void solveDirectly(const Blocks& blocks, Solver& solver, NodeArray& dv)
@@ -167,8 +175,10 @@ private:
   {
     preconditioner_ = diagonal_;
     blocks.addToPreconditioner(preconditioner_);
-    for (Matrix3& p : preconditioner_)
-      p = p.inverse().eval();
+    // The chains' nodes take the chains' solve instead (precondition).
+    for (std::size_t i = 0; i < preconditioner_.size(); ++i)
+      if (!(chain_preconditioner_ && chain_solver_.onPath(static_cast<int>(i))))
+        preconditioner_[i] = preconditioner_[i].inverse().eval();
     if (!chain_preconditioner_)
       return true;
     chain_solver_.start(diagonal_);
