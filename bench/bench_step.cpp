@@ -10,8 +10,10 @@
 // BM_Cable/<rod|spring_rope>/<nodes>: a cable by its material (rods.h) against the spring rope with bending
 // springs of the same mass, stretching stiffness and matrix pattern, implicit_euler at 1/60 s, clamped
 // (pinned) at one end; items = segments, so the two compare per segment per step.
-// BM_ClothLinearSolveAt60Hz/<cheaper|direct|iterative>/<nodes>: implicit Euler on the cloths at dt = 1/60 s,
-// 100 to 10,000 nodes, its linear solve made each way (cheaper: the rule's choice, what a scene gets).
+// BM_ClothLinearSolveAt60Hz/<cheaper|direct|iterative|multigrid>/<nodes>: implicit Euler on the cloths at
+// dt = 1/60 s, 100 to 100,000 nodes (direct to 10,000), its linear solve made each way (cheaper: the rule's
+// choice, what a scene gets; iterative: block-Jacobi conjugate gradients; multigrid: conjugate gradients
+// preconditioned by the multigrid cycle).
 // Contact (BM_RopeOnColliders/<shape>/<nodes>/<colliders>): a 1000-node rope lying across 10 spheres,
 // capsules, boxes or 10,000-triangle spheres as meshes, against the same rope with none (the price of contact, and that a scene without
 // colliders pays nothing for them); items = node-collider pairs checked per step.
@@ -753,9 +755,10 @@ BENCHMARK_CAPTURE(BM_RopeStepEngine, xpbd, IntegratorType::Xpbd)->Arg(100)->Arg(
 BENCHMARK_CAPTURE(BM_ClothStep, semi_implicit_euler, IntegratorType::SemiImplicitEuler)->Apply(clothSizes);
 BENCHMARK_CAPTURE(BM_ClothStep, xpbd, IntegratorType::Xpbd)->Apply(clothSizes);
 BENCHMARK_CAPTURE(BM_ClothStep, implicit_euler, IntegratorType::ImplicitEuler)->Apply(clothSizes);
-BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, cheaper, LinearSolve::Cheaper)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, cheaper, LinearSolve::Cheaper)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Arg(31623)->Arg(100000)->Unit(benchmark::kMillisecond);
 BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, direct, LinearSolve::Direct)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
-BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, iterative, LinearSolve::Iterative)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, iterative, LinearSolve::Iterative)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Arg(31623)->Arg(100000)->Unit(benchmark::kMillisecond);
+BENCHMARK_CAPTURE(BM_ClothLinearSolveAt60Hz, multigrid, LinearSolve::Multigrid)->Arg(100)->Arg(316)->Arg(1000)->Arg(3162)->Arg(10000)->Arg(31623)->Arg(100000)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_ClothSpringForces)->Arg(10000);
 BENCHMARK(BM_StiffRopeImplicitEuler)->Arg(100)->Arg(1000)->Arg(10000)->Arg(100000);
 BENCHMARK_CAPTURE(BM_Cable, rod, true)->Arg(100)->Arg(1000)->Arg(10000);

@@ -162,13 +162,15 @@ std::unique_ptr<Integrator> makeVelocityVerlet();
 std::unique_ptr<Integrator> makeRk4();
 std::unique_ptr<Integrator> makeImplicitEuler();
 /// How implicit_euler solves its linear systems: the cheaper path (its default), or one path always
-/// (Direct: block tridiagonal on chains, else sparse LDL^T at any cost; Iterative: conjugate gradients),
-/// for tests that compare them.
+/// (Direct: block tridiagonal on chains, else sparse LDL^T at any cost; Iterative: conjugate gradients
+/// preconditioned by block Jacobi; Multigrid: conjugate gradients preconditioned by a multigrid cycle), for
+/// tests and benchmarks that compare them.
 enum class LinearSolve
 {
   Cheaper,
   Direct,
   Iterative,
+  Multigrid,
 };
 std::unique_ptr<Integrator> makeImplicitEuler(LinearSolve solve);
 /// When implicit_euler's Newton iterations stop in a scene with soft solids (implicit_euler.cpp): after at

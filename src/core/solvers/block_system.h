@@ -8,9 +8,9 @@
 //   addToPreconditioner(blocks) each node's block of A not in diagonal() (kinds that keep theirs apart)
 //   write(solver)               addDiagonal / addOffDiagonal of those blocks into a direct solver
 // and chooses between the direct solves (block tridiagonal where the free nodes form chains, else a sparse
-// LDL^T) and preconditioned conjugate gradients by what they cost (see solve). Where some of the free nodes
-// form chains and others not (ropes beside a cloth), conjugate gradients solve the chains exactly in their
-// preconditioner (chain_preconditioner_).
+// LDL^T) and conjugate gradients, preconditioned by block Jacobi or by a multigrid cycle, by what they cost
+// (see solve). Where some of the free nodes form chains and others not (ropes beside a cloth), block-Jacobi
+// conjugate gradients solve the chains exactly in their preconditioner (chain_preconditioner_).
 #pragma once
 
 #include <algorithm>
@@ -23,6 +23,7 @@
 #include <Eigen/LU>
 
 #include "core/integrators/integrator_kit.h"
+#include "core/solvers/aggregation_multigrid.h"
 #include "core/solvers/block_tridiagonal_solver.h"
 #include "core/solvers/sparse_block_solver.h"
 #include "soft_body_sim/core/model.h"
@@ -59,10 +60,13 @@ public:
   {
     nodes_ = nodes;
     solid_sweeps_taken_ = 0.0;
-    chains_ = mode_ != LinearSolve::Iterative && tridiagonal_solver_.analyze(nodes, pairs_);
+    chains_ = !iterativeOnly() && tridiagonal_solver_.analyze(nodes, pairs_);
     factorable_ = chains_ && !sparse_too;
     if (factorable_)
+    {
       keepChainPreconditioner(false);  // every solve is the direct one
+      keepMultigrid(false);
+    }
     else
       analyzeSparse();
   }
@@ -70,11 +74,12 @@ public:
   /// preconditioner.
   void analyzeSparse()
   {
-    factorable_ = mode_ != LinearSolve::Iterative &&
+    factorable_ = !iterativeOnly() &&
                   sparse_solver_.analyze(nodes_, pairs_, mode_ == LinearSolve::Direct ? kAnyWork : kMaxFactorWork);
     keepChainPreconditioner(mode_ == LinearSolve::Cheaper && chain_solver_.analyzeChains(nodes_, pairs_));
+    keepMultigrid(false);  // analysed again where a solve first takes it
   }
-  bool iterativeOnly() const { return mode_ == LinearSolve::Iterative; }
+  bool iterativeOnly() const { return mode_ == LinearSolve::Iterative || mode_ == LinearSolve::Multigrid; }
 
   // --- the values of one Newton iteration -----------------------------------------------------------
   /// Per node: its diagonal block of A [kg], which the kinds add to (their diagonal blocks, unless they keep
@@ -126,11 +131,20 @@ public:
     const double solid_sweeps = solid_sweeps_ > 0.0 ? std::max(solid_sweeps_, solid_sweeps_taken_) : 0.0;
     const double cg_cost = std::max(kDirectWorkPerRootCondition * std::sqrt(condition_),
                                     kDirectWorkPerSolidSweep * solid_sweeps);
-    const bool cheaper_by_cg =
-        mode_ == LinearSolve::Cheaper && sparse_solver_.factorWork() / sparse_solver_.matrixEntries() > cg_cost;
+    // The multigrid cycle's cost hardly grows with the condition or the size (kMultigridWork). Not where
+    // the chains' exact solve serves (a stiff chain's sweeps under the cycle: 131 to 235 for a 1e4 N/m chain
+    // beside a cloth, test_linear_solvers, where the chains' solve leaves the cloth's), nor on soft solids,
+    // whose rotations its coarse levels leave out.
+    const bool by_multigrid =
+        mode_ == LinearSolve::Multigrid ||
+        (mode_ == LinearSolve::Cheaper && !chain_preconditioner_ && solid_sweeps == 0.0 && nodes_ >= kMultigridNodes &&
+         cg_cost > kMultigridWork);
+    const bool cheaper_by_cg = mode_ == LinearSolve::Cheaper && sparse_solver_.factorWork() /
+                                                                        sparse_solver_.matrixEntries() >
+                                                                    (by_multigrid ? kMultigridWork : cg_cost);
     if (!factorable_ || cheaper_by_cg)
     {
-      if (!buildPreconditioner(blocks))
+      if (!(by_multigrid ? buildMultigrid(blocks) : buildPreconditioner(blocks)))
       {
         dv.setConstant(3, rhs_.cols(), std::numeric_limits<double>::quiet_NaN());  // as solveDirectly's
         return;
@@ -153,6 +167,30 @@ private:
       chain_solver_ = BlockTridiagonalSolver();
   }
 
+  /// Whether the multigrid cycle's levels are kept (multigrid_ready_); without, their arrays are freed.
+  void keepMultigrid(bool keep)
+  {
+    multigrid_ready_ = keep;
+    if (!keep)
+      multigrid_.release();
+  }
+
+  /// The multigrid cycle as conjugate gradients' preconditioner, its pattern analysed where first taken
+  /// since analyze; false if A is not positive definite (as buildPreconditioner).
+  template <class Blocks>
+  bool buildMultigrid(const Blocks& blocks)
+  {
+    if (!multigrid_ready_)
+    {
+      multigrid_.analyze(nodes_, pairs_);
+      multigrid_ready_ = true;
+    }
+    multigrid_.start(diagonal_);
+    blocks.write(multigrid_);
+    by_multigrid_ = true;
+    return multigrid_.setup();
+  }
+
   /// Writes A into `solver` (analysed with the pattern's slots), factorises it and solves for dv.
   template <class Blocks, class Solver>
   void solveDirectly(const Blocks& blocks, Solver& solver, NodeArray& dv)
@@ -173,6 +211,7 @@ private:
   template <class Blocks>
   bool buildPreconditioner(const Blocks& blocks)
   {
+    by_multigrid_ = false;
     preconditioner_ = diagonal_;
     blocks.addToPreconditioner(preconditioner_);
     // The chains' nodes take the chains' solve instead (precondition).
@@ -197,6 +236,11 @@ private:
 
   void precondition(const NodeArray& r, NodeArray& z)
   {
+    if (by_multigrid_)
+    {
+      multigrid_.apply(r, z, *fine_product_);
+      return;
+    }
     if (!chain_preconditioner_)
     {
       for (Eigen::Index i = 0; i < r.cols(); ++i)
@@ -210,6 +254,19 @@ private:
   }
 
   static double dot(const NodeArray& a, const NodeArray& b) { return a.cwiseProduct(b).sum(); }
+
+  /// A p through the kinds' compact blocks, for the multigrid cycle's fine level.
+  template <class Blocks>
+  class FineProduct final : public AggregationMultigrid::FineProduct
+  {
+  public:
+    FineProduct(const BlockSystem& system, const Blocks& blocks) : system_(system), blocks_(blocks) {}
+    void operator()(const NodeArray& x, NodeArray& out) const override { system_.multiply(blocks_, x, out); }
+
+  private:
+    const BlockSystem& system_;
+    const Blocks& blocks_;
+  };
 
   /// dv = A^-1 rhs by preconditioned conjugate gradients from 0, stopped at a relative residual of
   /// kTolerance or after 2 * 3n iterations (the algorithm and the stopping rule of Eigen's
@@ -235,6 +292,8 @@ private:
       return 0;  // rhs so small (near underflow) that any iteration would divide by zero
     direction_.resize(3, n);
     product_.resize(3, n);
+    const FineProduct<Blocks> fine_product(*this, blocks);
+    fine_product_ = &fine_product;
     NodeArray& z = product_;
     precondition(residual, direction_);
     double r_dot_z = dot(residual, direction_);
@@ -286,6 +345,17 @@ private:
   /// entry), so the sweeps CG took in its last solve stand for the estimate where more (solidSweepsTaken):
   /// one solve by CG, then the cheaper factorisation.
   static constexpr double kDirectWorkPerSolidSweep = 0.7;
+  /// Multigrid-preconditioned conjugate gradients (AggregationMultigrid) in the units of
+  /// kDirectWorkPerRootCondition: measured on the benchmark cloth at 1/60 s (bench_step
+  /// BM_ClothLinearSolveAt60Hz, docs/RESULTS.md "Multigrid"), 29 to 40 sweeps from 1,024 to 99,856 nodes
+  /// where block Jacobi takes 110 to 417, each sweep about five of block Jacobi's and the levels' setup about
+  /// 60 more: about 230 block-Jacobi sweeps a solve, which block Jacobi, at about 14 sweeps per square root
+  /// of the condition on this cloth (417 at sqrt(condition) 29), costs at 4 sqrt(condition) = 66.
+  static constexpr double kMultigridWork = 66.0;
+  /// Below this many nodes block Jacobi's sweeps have not reached their bound (the cloth's smoothest modes
+  /// are not yet felt): at 1,024 nodes the two cost the same (8.4 and 8.6 ms), at 3,136 multigrid is 1.3
+  /// times faster (28.6 and 37.9 ms), at 324 slower.
+  static constexpr int kMultigridNodes = 2000;
   /// No factorisation is even prepared beyond this work per entry (a 100,000-node cloth would need
   /// 0.75 GB for its factor).
   static constexpr double kMaxFactorWork = 2000.0;
@@ -316,6 +386,11 @@ private:
   /// LinearSolve::Iterative stays plain block Jacobi.
   bool chain_preconditioner_ = false;
   BlockTridiagonalSolver chain_solver_;  ///< the chains among the pattern (analyzeChains)
+  AggregationMultigrid multigrid_;       ///< the multigrid cycle, where the rule takes it (solve)
+  bool multigrid_ready_ = false;         ///< multigrid_ is analysed for the pattern
+  bool by_multigrid_ = false;            ///< the solve under way is preconditioned by multigrid_
+  /// The fine product of the solve under way for multigrid_ (set by solveIteratively, read only within it).
+  const AggregationMultigrid::FineProduct* fine_product_ = nullptr;
 };
 
 }  // namespace soft_body_sim
