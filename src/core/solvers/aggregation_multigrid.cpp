@@ -22,8 +22,9 @@ void AggregationMultigrid::analyze(int nodes, const std::vector<std::pair<int, i
   }
   levels_.assign(1, Level());
   BlockRows& a = levels_.front().a;
+  std::vector<std::size_t>& diagonal = levels_.front().diagonal;
   a.clear(nodes);
-  diagonal_position_.resize(n);
+  diagonal.resize(n);
   for (std::size_t i = 0; i < n; ++i)
   {
     std::vector<int>& row = neighbours[i];
@@ -32,10 +33,9 @@ void AggregationMultigrid::analyze(int nodes, const std::vector<std::pair<int, i
     const std::size_t first = a.column.size();
     a.column.insert(a.column.end(), row.begin(), row.end());
     a.start.push_back(a.column.size());
-    diagonal_position_[i] = first + static_cast<std::size_t>(std::lower_bound(row.begin(), row.end(), static_cast<int>(i)) - row.begin());
+    diagonal[i] = first + static_cast<std::size_t>(std::lower_bound(row.begin(), row.end(), static_cast<int>(i)) - row.begin());
   }
   a.block.assign(a.column.size(), Matrix3::Zero());
-  levels_.front().diagonal = diagonal_position_;
   const auto position = [&](int row, int column) {
     const auto begin = a.column.begin() + static_cast<std::ptrdiff_t>(a.start[static_cast<std::size_t>(row)]);
     const auto end = a.column.begin() + static_cast<std::ptrdiff_t>(a.start[static_cast<std::size_t>(row) + 1]);
@@ -49,7 +49,6 @@ void AggregationMultigrid::analyze(int nodes, const std::vector<std::pair<int, i
 
 void AggregationMultigrid::release()
 {
-  std::vector<std::size_t>().swap(diagonal_position_);
   std::vector<std::pair<std::size_t, std::size_t>>().swap(slot_position_);
   std::vector<Level>().swap(levels_);
   level_count_ = 0;
@@ -58,15 +57,16 @@ void AggregationMultigrid::release()
   coarsest_rhs_.resize(0);
   std::vector<std::ptrdiff_t>().swap(mark_);
   std::vector<int>().swap(roots_took_);
+  std::vector<double>().swap(diagonal_norm_);
   std::vector<std::size_t>().swap(next_);
 }
 
 void AggregationMultigrid::start(const std::vector<Matrix3>& diagonal)
 {
-  std::vector<Matrix3>& blocks = levels_.front().a.block;
-  std::fill(blocks.begin(), blocks.end(), Matrix3::Zero());
-  for (std::size_t i = 0; i < diagonal_position_.size(); ++i)
-    blocks[diagonal_position_[i]] = diagonal[i];
+  Level& fine = levels_.front();
+  std::fill(fine.a.block.begin(), fine.a.block.end(), Matrix3::Zero());
+  for (std::size_t i = 0; i < fine.diagonal.size(); ++i)
+    fine.a.block[fine.diagonal[i]] = diagonal[i];
 }
 
 bool AggregationMultigrid::setup()
@@ -137,11 +137,15 @@ int AggregationMultigrid::aggregate(Level& level, double strength_threshold)
   std::vector<int>& aggregate = level.aggregate;
   aggregate.assign(static_cast<std::size_t>(n), -1);
   const double threshold2 = strength_threshold * strength_threshold;
-  const auto diagonalNorm = [&](int i) { return a.block[level.diagonal[static_cast<std::size_t>(i)]].norm(); };
+  std::vector<double>& diagonal_norm = diagonal_norm_;
+  diagonal_norm.resize(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < diagonal_norm.size(); ++i)
+    diagonal_norm[i] = a.block[level.diagonal[i]].norm();
   // Entry k of row i couples strongly: |A_ij|^2 >= threshold^2 |A_ii| |A_jj|.
   const auto strong = [&](int i, std::size_t k) {
     const int j = a.column[k];
-    return j != i && a.block[k].squaredNorm() >= threshold2 * diagonalNorm(i) * diagonalNorm(j);
+    return j != i && a.block[k].squaredNorm() >=
+                         threshold2 * diagonal_norm[static_cast<std::size_t>(i)] * diagonal_norm[static_cast<std::size_t>(j)];
   };
   int count = 0;
   // Roots: a node whose strong neighbours are all free takes them into a new aggregate. A node with no
@@ -198,24 +202,14 @@ void AggregationMultigrid::makeProlongation(Level& level, int aggregates)
   for (std::size_t i = 0; i < n; ++i)
   {
     const std::ptrdiff_t row_start = static_cast<std::ptrdiff_t>(p.block.size());
-    const auto entry = [&](int column) -> Matrix3& {
-      std::ptrdiff_t& at = mark_[static_cast<std::size_t>(column)];
-      if (at < row_start)
-      {
-        at = static_cast<std::ptrdiff_t>(p.block.size());
-        p.column.push_back(column);
-        p.block.push_back(Matrix3::Zero());
-      }
-      return p.block[static_cast<std::size_t>(at)];
-    };
     if (level.aggregate[i] >= 0)
-      entry(level.aggregate[i]) += Matrix3::Identity();
+      p.rowEntry(level.aggregate[i], row_start, mark_) += Matrix3::Identity();
     // - w D_i^-1 A_ij for each neighbour j in an aggregate (j = i included: -w I)
     for (std::size_t k = a.start[i]; k < a.start[i + 1]; ++k)
     {
       const int j = level.aggregate[static_cast<std::size_t>(a.column[k])];
       if (j >= 0)
-        entry(j) -= level.smoother[i] * a.block[k];
+        p.rowEntry(j, row_start, mark_) -= level.smoother[i] * a.block[k];
     }
     p.start.push_back(p.block.size());
   }
@@ -320,16 +314,7 @@ void AggregationMultigrid::multiply(const BlockRows& a, const BlockRows& b, Bloc
     {
       const std::size_t middle = static_cast<std::size_t>(a.column[k]);
       for (std::size_t m = b.start[middle]; m < b.start[middle + 1]; ++m)
-      {
-        std::ptrdiff_t& at = mark[static_cast<std::size_t>(b.column[m])];
-        if (at < row_start)
-        {
-          at = static_cast<std::ptrdiff_t>(out.block.size());
-          out.column.push_back(b.column[m]);
-          out.block.push_back(Matrix3::Zero());
-        }
-        out.block[static_cast<std::size_t>(at)].noalias() += a.block[k] * b.block[m];
-      }
+        out.rowEntry(b.column[m], row_start, mark).noalias() += a.block[k] * b.block[m];
     }
     out.start.push_back(out.block.size());
   }

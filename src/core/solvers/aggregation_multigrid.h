@@ -52,7 +52,8 @@ public:
   /// A's diagonal block of node i += block (symmetric).
   void addDiagonal(int i, const Matrix3& block)
   {
-    levels_.front().a.block[diagonal_position_[static_cast<std::size_t>(i)]] += block;
+    Level& fine = levels_.front();
+    fine.a.block[fine.diagonal[static_cast<std::size_t>(i)]] += block;
   }
   /// A's block (a, b) += block, and (b, a) += block^T, for the pair (a, b) of slot `slot`.
   void addOffDiagonal(std::size_t slot, const Matrix3& block)
@@ -96,6 +97,20 @@ private:
     std::vector<Matrix3> block;
 
     int rows() const { return static_cast<int>(start.size()) - 1; }
+    /// The block in column `in_column` of the row being made (its blocks from row_start on), appended if the row has
+    /// none yet; `mark` holds, per column, where its block last went (any value below row_start: none in
+    /// this row).
+    Matrix3& rowEntry(int in_column, std::ptrdiff_t row_start, std::vector<std::ptrdiff_t>& mark)
+    {
+      std::ptrdiff_t& at = mark[static_cast<std::size_t>(in_column)];
+      if (at < row_start)
+      {
+        at = static_cast<std::ptrdiff_t>(block.size());
+        column.push_back(in_column);
+        block.push_back(Matrix3::Zero());
+      }
+      return block[static_cast<std::size_t>(at)];
+    }
     void clear(int columns_count)
     {
       columns = columns_count;
@@ -151,7 +166,6 @@ private:
   /// threshold halved on each coarser level (Vaněk, Mandel and Brezina's epsilon = 0.08 * 0.5^level).
   static constexpr double kStrengthThreshold = 0.08;
 
-  std::vector<std::size_t> diagonal_position_;                     ///< per fine node: its block in a
   std::vector<std::pair<std::size_t, std::size_t>> slot_position_;  ///< per slot: its blocks (a, b), (b, a)
   std::vector<Level> levels_;
   std::size_t level_count_ = 0;
@@ -161,6 +175,7 @@ private:
   Eigen::VectorXd coarsest_rhs_;
   std::vector<std::ptrdiff_t> mark_;  ///< scratch: where a column's block is in the row being made
   std::vector<int> roots_took_;       ///< scratch: the aggregates before the left-over nodes join them
+  std::vector<double> diagonal_norm_;  ///< scratch: each node's |A_ii| (aggregate)
   std::vector<std::size_t> next_;     ///< scratch: transpose's next place in each row
 };
 

@@ -149,7 +149,7 @@ public:
         dv.setConstant(3, rhs_.cols(), std::numeric_limits<double>::quiet_NaN());  // as solveDirectly's
         return;
       }
-      const double sweeps = static_cast<double>(solveIteratively(blocks, dv));
+      const double sweeps = static_cast<double>(solveIteratively(blocks, by_multigrid, dv));
       if (solid_sweeps_ > 0.0)
         solid_sweeps_taken_ = sweeps;
       return;
@@ -187,7 +187,6 @@ private:
     }
     multigrid_.start(diagonal_);
     blocks.write(multigrid_);
-    by_multigrid_ = true;
     return multigrid_.setup();
   }
 
@@ -211,7 +210,6 @@ private:
   template <class Blocks>
   bool buildPreconditioner(const Blocks& blocks)
   {
-    by_multigrid_ = false;
     preconditioner_ = diagonal_;
     blocks.addToPreconditioner(preconditioner_);
     // The chains' nodes take the chains' solve instead (precondition).
@@ -234,11 +232,13 @@ private:
     blocks.multiply(p, out);
   }
 
-  void precondition(const NodeArray& r, NodeArray& z)
+  /// z = M^-1 r: the multigrid cycle where `multigrid` (its fine level's product) is given, else block
+  /// Jacobi (with the chains' solve).
+  void precondition(const NodeArray& r, NodeArray& z, const AggregationMultigrid::FineProduct* multigrid)
   {
-    if (by_multigrid_)
+    if (multigrid)
     {
-      multigrid_.apply(r, z, *fine_product_);
+      multigrid_.apply(r, z, *multigrid);
       return;
     }
     if (!chain_preconditioner_)
@@ -270,15 +270,15 @@ private:
 
   /// dv = A^-1 rhs by preconditioned conjugate gradients from 0, stopped at a relative residual of
   /// kTolerance or after 2 * 3n iterations (the algorithm and the stopping rule of Eigen's
-  /// ConjugateGradient), multiplying by the blocks directly, preconditioned by the inverse of each node's
-  /// 3x3 diagonal block.
+  /// ConjugateGradient), multiplying by the blocks directly, preconditioned by the multigrid cycle where
+  /// `by_multigrid`, else by the inverse of each node's 3x3 diagonal block (and the chains' solve).
   ///
   /// The residual takes the right-hand side's place (rhs_, which the next assembly makes anew), and the
   /// preconditioned residual z the product's (A direction, not needed once the residual is updated): two
   /// vectors where Eigen's takes four, 48 bytes a node.
   /// Returns the sweeps it took.
   template <class Blocks>
-  Eigen::Index solveIteratively(const Blocks& blocks, NodeArray& dv)
+  Eigen::Index solveIteratively(const Blocks& blocks, bool by_multigrid, NodeArray& dv)
   {
     const Eigen::Index n = rhs_.cols();
     dv.setZero(3, n);
@@ -293,9 +293,9 @@ private:
     direction_.resize(3, n);
     product_.resize(3, n);
     const FineProduct<Blocks> fine_product(*this, blocks);
-    fine_product_ = &fine_product;
+    const AggregationMultigrid::FineProduct* multigrid = by_multigrid ? &fine_product : nullptr;
     NodeArray& z = product_;
-    precondition(residual, direction_);
+    precondition(residual, direction_, multigrid);
     double r_dot_z = dot(residual, direction_);
     const Eigen::Index max_iterations = 2 * 3 * n;
     Eigen::Index iteration = 0;
@@ -309,7 +309,7 @@ private:
       residual_norm2 = residual.squaredNorm();
       if (residual_norm2 < threshold)
         break;
-      precondition(residual, z);
+      precondition(residual, z, multigrid);
       const double previous_r_dot_z = r_dot_z;
       r_dot_z = dot(residual, z);
       direction_ = z + (r_dot_z / previous_r_dot_z) * direction_;
@@ -388,9 +388,6 @@ private:
   BlockTridiagonalSolver chain_solver_;  ///< the chains among the pattern (analyzeChains)
   AggregationMultigrid multigrid_;       ///< the multigrid cycle, where the rule takes it (solve)
   bool multigrid_ready_ = false;         ///< multigrid_ is analysed for the pattern
-  bool by_multigrid_ = false;            ///< the solve under way is preconditioned by multigrid_
-  /// The fine product of the solve under way for multigrid_ (set by solveIteratively, read only within it).
-  const AggregationMultigrid::FineProduct* fine_product_ = nullptr;
 };
 
 }  // namespace soft_body_sim
