@@ -47,4 +47,25 @@ inline ColumnPair loadColumns(const double* array, std::ptrdiff_t i0, std::ptrdi
   column[2] -= z;
 }
 
+/// Columns i and i + 1 of a 3 x N column-major array, the six doubles from `column` (a run's ends).
+inline ColumnPair loadRun2(const double* column)
+{
+  const Packet xy = _mm_loadu_pd(column);      // x0 y0
+  const Packet zx = _mm_loadu_pd(column + 2);  // z0 x1
+  const Packet yz = _mm_loadu_pd(column + 4);  // y1 z1
+  return { _mm_shuffle_pd(xy, zx, 0b10), _mm_shuffle_pd(xy, yz, 0b01), _mm_shuffle_pd(zx, yz, 0b10) };
+}
+
+/// The six doubles from `column` (columns i, i + 1) plus (sign 1) or minus (sign -1) the lanes' columns.
+template <int sign>
+inline void addToRun2(double* column, const Packet& x, const Packet& y, const Packet& z)
+{
+  const Packet part[3] = { _mm_unpacklo_pd(x, y), _mm_shuffle_pd(z, x, 0b10), _mm_unpackhi_pd(y, z) };
+  for (int p = 0; p < 3; ++p)
+  {
+    const Packet now = _mm_loadu_pd(column + 2 * p);
+    _mm_storeu_pd(column + 2 * p, sign > 0 ? now + part[p] : now - part[p]);
+  }
+}
+
 }  // namespace soft_body_sim

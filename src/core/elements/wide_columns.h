@@ -54,4 +54,34 @@ SOFT_BODY_SIM_WIDE void lanePairs(__m256d x, __m256d y, __m128d xy[4])
   xy[3] = _mm256_extractf128_pd(high, 1);
 }
 
+/// Columns i .. i + 3 of a 3 x N column-major array, the twelve doubles from `column` (a run's ends), by
+/// three loads transposed in registers.
+SOFT_BODY_SIM_WIDE ColumnQuad loadRun4(const double* column)
+{
+  const __m256d lo = _mm256_loadu_pd(column);        // x0 y0 z0 x1
+  const __m256d mid = _mm256_loadu_pd(column + 4);   // y1 z1 x2 y2
+  const __m256d hi = _mm256_loadu_pd(column + 8);    // z2 x3 y3 z3
+  const __m256d xy = _mm256_blend_pd(lo, mid, 0b1100);         // x0 y0 x2 y2
+  const __m256d zx = _mm256_permute2f128_pd(lo, hi, 0x21);     // z0 x1 z2 x3
+  const __m256d yz = _mm256_blend_pd(mid, hi, 0b1100);         // y1 z1 y3 z3
+  return { _mm256_blend_pd(xy, zx, 0b1010), _mm256_shuffle_pd(xy, yz, 0b0101), _mm256_blend_pd(zx, yz, 0b1010) };
+}
+
+/// The twelve doubles from `column` (columns i .. i + 3) plus (sign 1) or minus (sign -1) the columns
+/// (x_l, y_l, z_l) of the lanes, each double by one addition or subtraction.
+template <int sign>
+SOFT_BODY_SIM_WIDE void addToRun4(double* column, __m256d x, __m256d y, __m256d z)
+{
+  const __m256d xy = _mm256_unpacklo_pd(x, y);         // x0 y0 x2 y2
+  const __m256d yz = _mm256_unpackhi_pd(y, z);         // y1 z1 y3 z3
+  const __m256d zx = _mm256_shuffle_pd(z, x, 0b1010);  // z0 x1 z2 x3
+  const __m256d part[3] = { _mm256_permute2f128_pd(xy, zx, 0x20), _mm256_blend_pd(yz, xy, 0b1100),
+                            _mm256_permute2f128_pd(zx, yz, 0x31) };
+  for (int p = 0; p < 3; ++p)
+  {
+    const __m256d now = _mm256_loadu_pd(column + 4 * p);
+    _mm256_storeu_pd(column + 4 * p, sign > 0 ? now + part[p] : now - part[p]);
+  }
+}
+
 }  // namespace soft_body_sim

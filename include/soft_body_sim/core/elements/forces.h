@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "soft_body_sim/core/model.h"
@@ -31,9 +32,21 @@ inline double springTension(const Spring& s, const Vec3& u, double length, const
   return s.stiffness * (length - s.rest_length) + s.damping * (v.col(s.a) - v.col(s.b)).dot(u);
 }
 
-/// The model's springs as accumulateSpringForces reads them: one array per field, in the order of a greedy
-/// edge colouring, so that no two consecutive springs share a node (in model order each `force.col(a) += f`
-/// of a rope or a cloth waits for the previous spring's store to the same node). A copy of the springs'
+/// Springs [start, start + count) of SpringArrays join node a + i to node a + i + distance, i = 0 .. count - 1
+/// (a cloth's row or column, a rope), so that the kernel loads and adds four consecutive nodes' columns at a
+/// time: three loads of twelve doubles rather than a load per node and coordinate.
+struct SpringRun
+{
+  std::uint32_t start = 0;
+  std::uint32_t count = 0;
+  int a = 0;         ///< end a of the run's first spring
+  int distance = 0;  ///< b - a: 1 or 2 (each node an end of two consecutive springs), or at least kFarRun
+};
+
+/// The model's springs as accumulateSpringForces reads them: one array per field. First the runs
+/// (SpringRun, their springs' ends ordered a < b), then the other springs in the order of a greedy edge
+/// colouring, so that no two consecutive springs share a node (in model order each `force.col(a) += f` of a
+/// rope or a cloth waits for the previous spring's store to the same node). A copy of the springs'
 /// parameters: made again when the model changes.
 struct SpringArrays
 {
@@ -42,12 +55,22 @@ struct SpringArrays
   std::vector<double> rest_length;  ///< [m]
   std::vector<double> stiffness;    ///< k [N/m]
   std::vector<double> damping;      ///< c [N s/m]
+  std::vector<SpringRun> runs;      ///< over springs [0, run_springs)
+  std::size_t run_springs = 0;
 
   std::size_t size() const { return a.size(); }
+
+  /// A run's ends at least this far apart: four consecutive springs' b ends are none of the next four's a ends.
+  static constexpr int kFarRun = 8;
+  /// Shorter rows of consecutive springs are left to the colouring.
+  static constexpr std::uint32_t kLeastRun = 8;
+  /// Longer runs are cut (their parts ordered by their first node, so that a cloth's rows are visited row by
+  /// row, its nodes in cache, rather than a column's springs across the whole cloth at once).
+  static constexpr std::uint32_t kMostRun = 128;
 };
 SpringArrays springArrays(const Model& model);
 
-/// Adds every spring's Hooke + dashpot force [N] to `force` (see Spring).
+/// Adds every spring's Hooke + dashpot force [N] to `force` (see Spring), the runs' first.
 void accumulateSpringForces(const SpringArrays& springs, const NodeArray& x, const NodeArray& v, NodeArray& force);
 
 /// Below this fraction a of its rest area (a cell) or volume (a tetrahedron) a gas's law continues as a
