@@ -273,7 +273,7 @@ TEST(SpringForces, RunsAndColoursGiveEverySpringsTensionOnceWithFourLanesOrTwo)
   // or runs too short to be one). A spring missed or counted twice would be off by its whole force; the
   // two sums differ by their roundings only.
   ClothDef cloth;
-  cloth.nx = 37;  // rows of 36 springs and of 35 bending springs: runs of 4 n, 4 n + 1, 4 n + 3 springs
+  cloth.nx = 38;  // rows of 37 springs and 36 bending springs, the rope's last parts 43 and 42: 0 to 3 after the fours
   cloth.ny = 9;
   cloth.bending = SpringParameters{ 20.0, 0.01 };
   RopeDef rope;
