@@ -270,7 +270,9 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
   skin_ = kSkinRadii * largest_radius_;
   for (std::size_t s = 0; s < segments_.size(); ++s)
   {
-    const double radii = by_faces_[static_cast<std::size_t>(body_[s])] ? kNearRadiiOfEdges : kNearRadiiOfLinks;
+    const bool ball = segments_[s].first == segments_[s].second;
+    const double radii = ball ? kNearRadiiOfBalls
+                              : by_faces_[static_cast<std::size_t>(body_[s])] ? kNearRadiiOfEdges : kNearRadiiOfLinks;
     near_radius_.push_back(radii * radius_[s]);
     widest_near_ = std::max(widest_near_, near_radius_.back());
   }
