@@ -267,15 +267,22 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
     nodes_.insert(nodes_.end(), { a, b });
   std::sort(nodes_.begin(), nodes_.end());
   nodes_.erase(std::unique(nodes_.begin(), nodes_.end()), nodes_.end());
-  skin_ = kSkinRadii * largest_radius_;
+  std::vector<double> least_skin(static_cast<std::size_t>(model.nodeCount()), std::numeric_limits<double>::infinity());
   for (std::size_t s = 0; s < segments_.size(); ++s)
   {
     const bool ball = segments_[s].first == segments_[s].second;
     const double radii = ball ? kNearRadiiOfBalls
                               : by_faces_[static_cast<std::size_t>(body_[s])] ? kNearRadiiOfEdges : kNearRadiiOfLinks;
+    const double skin = (ball ? kSkinRadiiOfBalls : kSkinRadii) * largest_radius_;
     near_radius_.push_back(radii * radius_[s]);
-    widest_near_ = std::max(widest_near_, near_radius_.back());
+    search_radius_.push_back(near_radius_.back() + 0.5 * skin);
+    widest_search_ = std::max(widest_search_, search_radius_.back());
+    skin_ = std::max(skin_, skin);
+    for (const int node : { segments_[s].first, segments_[s].second })
+      least_skin[static_cast<std::size_t>(node)] = std::min(least_skin[static_cast<std::size_t>(node)], skin);
   }
+  for (const int node : nodes_)
+    hold_limit_.push_back(0.25 * least_skin[static_cast<std::size_t>(node)] * least_skin[static_cast<std::size_t>(node)]);
   findRestNeighbours();
   if (faces_.empty())
     return;
@@ -313,11 +320,11 @@ bool SelfContacts::candidatesHold(const NodeArray& x)
     high = high.cwiseMax(displacement);
   }
   const Vec3 middle = 0.5 * (low + high);
-  const double limit = 0.25 * skin_ * skin_;
-  for (const int node : nodes_)
+  for (std::size_t k = 0; k < nodes_.size(); ++k)
   {
+    const int node = nodes_[k];
     const double moved2 = (x.col(node) - found_at_.col(node) - middle).squaredNorm();
-    if (moved2 > limit)
+    if (moved2 > hold_limit_[k])
       return false;
     moved_[static_cast<std::size_t>(node)] = std::sqrt(moved2);
   }
@@ -326,9 +333,9 @@ bool SelfContacts::candidatesHold(const NodeArray& x)
 
 void SelfContacts::findCandidates(const NodeArray& x)
 {
-  // A candidate pair's links come within their near radii and the skin (see below): their balls within
-  // the widest such reach.
-  const double reach = 2.0 * widest_near_ + skin_;
+  // A candidate pair's links come within their search radii together (near radii and skins): their balls
+  // within the widest such reach.
+  const double reach = 2.0 * widest_search_;
   gridSegments(x, reach);
   candidates_.clear();
   // Marks (1) or unmarks (0) segment s's later neighbours at rest, which it never touches; none for
@@ -357,7 +364,7 @@ void SelfContacts::findCandidates(const NodeArray& x)
     }
     if (rest_near_mark_[t] != 0)
       return;
-    const double within = near_radius_[s] + near_radius_[t] + skin_;
+    const double within = search_radius_[s] + search_radius_[t];
     if (a == b && c == d)
     {
       // Two balls: their middles are their centres, so the distance is the bound below and the least
