@@ -191,7 +191,7 @@ public:
   /// or more, against 0.95). A cloth's or jelly's nodes as balls once over too: twice over, with the skin, reached its
   /// nodes two spacings apart in its own plane (4 cm at 2 cm spacing and 8 mm thickness, within 2 x 1.6 cm + 1.6 cm),
   /// six candidates a node in a flat cloth that never touch, searched for and bounded every sub-step
-  /// (ClothOnSphere/self_collision 9.9 to 7.5 ms a step; the folded cloth's layers 1.309 and 1.311 thicknesses apart).
+  /// (ClothOnSphere/self_collision 10.2 to 7.5 ms a step; the folded cloth's layers 1.309 and 1.311 thicknesses apart).
   static constexpr double kNearRadiiOfLinks = 2.0;
   static constexpr double kNearRadiiOfEdges = 1.0;
   static constexpr double kNearRadiiOfBalls = 1.0;
@@ -200,11 +200,11 @@ public:
   /// radii, and kept until some node has moved half the skin relative to a common motion (a Verlet
   /// list, as in molecular dynamics): a pile at rest, or a cloth falling flat, is searched once, not
   /// every sub-step. A link's or edge's skin is kSkinRadii; a ball's kSkinRadiiOfBalls, since its near
-  /// radius is one radius (kNearRadiiOfBalls) and a skin of three still leaves a flat cloth's nodes two
-  /// spacings apart out (ClothOnSphere/self_collision 7.5 ms a step with 2, 6.4 with 2.5, 5.9 with 3, 6.7
+  /// radius is one radius (kNearRadiiOfBalls) and a skin of three still leaves out a flat cloth's nodes
+  /// two spacings apart (ClothOnSphere/self_collision 7.5 ms a step with 2, 6.4 with 2.5, 5.9 with 3, 6.7
   /// with 4; a coiled rope's links 338 us with 2, 350 with 2.5, 382 with 3). A pair is found within the
   /// mean of its two skins, and a node keeps the list while it has moved less than half the least skin of
-  /// its segments: a pair's links then come no nearer than the mean skin.
+  /// its segments: a pair's links then come nearer by at most the mean of their skins.
   static constexpr double kSkinRadii = 2.0;
   static constexpr double kSkinRadiiOfBalls = 3.0;
 
@@ -212,7 +212,7 @@ private:
   /// True if no node of a colliding link has moved half its least skin, relative to a common motion, since
   /// the candidates were found; each node's distance so moved into moved_.
   bool candidatesHold(const NodeArray& x);
-  /// The pairs within their near radii (kNearRadiiOfLinks) and the skin, through the spatial hash.
+  /// The pairs within their search radii together (near radii and skins), through the spatial hash.
   void findCandidates(const NodeArray& x);
   /// Each segment as a ball at positions y (about its midpoint, of half its length) into middle_ and half_,
   /// and grid_ built over them for pairs within `reach` [m] of each other.
