@@ -144,8 +144,7 @@ TEST(BallGrid, VisitsEveryPairAndEveryBallWithinReachOnce)
 // edges) each time, the list found at the start holds (one search in 40 moves), and each resolution
 // equals that of a fresh search at the moved positions bit for bit (the pairs are taken in an order no
 // search changes). A node moved 4 cm relative to the others (2 cm from the middle of the displacements)
-// makes it search again. By the cloths' nodes as balls, and by their
-// triangles' edges and faces.
+// makes it search again. By the cloths' nodes as balls, and by their triangles' edges and faces.
 class CandidateList : public ::testing::TestWithParam<bool>
 {
 };

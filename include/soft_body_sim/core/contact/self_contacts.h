@@ -94,6 +94,11 @@ void BallGrid::visitCells(const std::uint32_t* cells, int count, const Vec3& p, 
   constexpr int kBatch = 64;
   std::uint32_t found[kBatch];
   int taken = 0;
+  const auto visit_taken = [&] {
+    for (int k = 0; k < taken; ++k)
+      visit(static_cast<std::size_t>(found[k]));
+    taken = 0;
+  };
   for (int q = 0; q < count; ++q)
   {
     // A cell's balls are in ascending order (build's counting sort): those after `after` are a tail, found
@@ -110,15 +115,10 @@ void BallGrid::visitCells(const std::uint32_t* cells, int count, const Vec3& p, 
       found[taken] = sorted[e];
       taken += static_cast<int>(dx * dx + dy * dy + dz * dz < reach * reach);
       if (taken == kBatch)
-      {
-        for (int k = 0; k < taken; ++k)
-          visit(static_cast<std::size_t>(found[k]));
-        taken = 0;
-      }
+        visit_taken();
     }
   }
-  for (int k = 0; k < taken; ++k)
-    visit(static_cast<std::size_t>(found[k]));
+  visit_taken();
 }
 
 template <typename Visit>
