@@ -78,6 +78,30 @@ void sortWithinRuns(std::vector<Item>& items, Group group, Within within)
   }
 }
 
+/// Sorts `items` by (group, within), group(item) < groups: by group with a counting sort (through
+/// `scratch`; start[g] is then where group g's run begins, start[groups] the end), then inside each group
+/// (sortWithinRuns). A search that finds its pairs in no order of their first item (BallGrid's cell by
+/// cell) orders them in a time linear in their count.
+template <typename Item, typename Group, typename Within>
+void sortByGroups(std::vector<Item>& items, std::size_t groups, Group group, Within within, std::vector<Item>& scratch,
+                  std::vector<std::uint32_t>& start)
+{
+  start.assign(groups + 1, 0);
+  for (const Item& item : items)
+    ++start[static_cast<std::size_t>(group(item)) + 1];
+  for (std::size_t g = 0; g < groups; ++g)
+    start[g + 1] += start[g];
+  scratch.resize(items.size());
+  for (const Item& item : items)
+    scratch[start[static_cast<std::size_t>(group(item))]++] = item;
+  // start[g] is now where group g + 1 begins: shifted back by one.
+  for (std::size_t g = groups; g > 0; --g)
+    start[g] = start[g - 1];
+  start[0] = 0;
+  items.swap(scratch);
+  sortWithinRuns(items, group, within);
+}
+
 }  // namespace
 
 std::int32_t BallGrid::coordinate(double position) const
@@ -106,7 +130,7 @@ bool BallGrid::sameCell(std::uint32_t cell, const std::int32_t* c) const
   return key[0] == c[0] && key[1] == c[1] && key[2] == c[2];
 }
 
-int BallGrid::cellsAround(const std::int32_t* c, std::uint32_t* cells) const
+int BallGrid::cellsAround(const std::int32_t* c, int first, std::uint32_t* cells) const
 {
   // The hash's three terms for each axis's three cells, each worked out once.
   std::uint64_t term[3][3];
@@ -116,26 +140,25 @@ int BallGrid::cellsAround(const std::int32_t* c, std::uint32_t* cells) const
   const std::size_t mask = table_.size() - 1;
   int count = 0;
   std::int32_t around[3];
-  for (int di = 0; di < 3; ++di)
-    for (int dj = 0; dj < 3; ++dj)
-      for (int dk = 0; dk < 3; ++dk)
+  for (int index = first; index < 27; ++index)
+  {
+    const int di = index / 9, dj = index / 3 % 3, dk = index % 3;
+    around[0] = c[0] + di - 1;
+    around[1] = c[1] + dj - 1;
+    around[2] = c[2] + dk - 1;
+    // Linear probing: the cell's entry, or an empty one where it would be (most of them).
+    for (std::size_t slot = slotOf(term[0][di] ^ term[1][dj] ^ term[2][dk]);; slot = (slot + 1) & mask)
+    {
+      const std::uint32_t cell = table_[slot];
+      if (cell == kEmpty)
+        break;
+      if (sameCell(cell, around))
       {
-        around[0] = c[0] + di - 1;
-        around[1] = c[1] + dj - 1;
-        around[2] = c[2] + dk - 1;
-        // Linear probing: the cell's entry, or an empty one where it would be (most of them).
-        for (std::size_t slot = slotOf(term[0][di] ^ term[1][dj] ^ term[2][dk]);; slot = (slot + 1) & mask)
-        {
-          const std::uint32_t cell = table_[slot];
-          if (cell == kEmpty)
-            break;
-          if (sameCell(cell, around))
-          {
-            cells[count++] = cell;
-            break;
-          }
-        }
+        cells[count++] = cell;
+        break;
       }
+    }
+  }
   return count;
 }
 
@@ -262,7 +285,6 @@ SelfContacts::SelfContacts(const Model& model, const NodeArray& rest)
     rest_ = rest;  // a scene without self-collision keeps no copy
   middle_.setZero(3, static_cast<Eigen::Index>(segments_.size()));
   half_.assign(segments_.size(), 0.0);
-  rest_near_mark_.assign(segments_.size(), 0);
   for (const auto& [a, b] : segments_)
     nodes_.insert(nodes_.end(), { a, b });
   std::sort(nodes_.begin(), nodes_.end());
@@ -338,14 +360,6 @@ void SelfContacts::findCandidates(const NodeArray& x)
   const double reach = 2.0 * widest_search_;
   gridSegments(x, reach);
   candidates_.clear();
-  // Marks (1) or unmarks (0) segment s's later neighbours at rest, which it never touches; none for
-  // s = -1 or without face-contact cloths.
-  const auto mark = [&](std::size_t s, char value) {
-    if (s < segments_.size() && !rest_near_start_.empty())
-      for (std::uint32_t k = rest_near_start_[s]; k < rest_near_start_[s + 1]; ++k)
-        rest_near_mark_[rest_near_[k]] = value;
-  };
-  std::size_t marked = static_cast<std::size_t>(-1);
   grid_.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
     if (shareANode(s, t))
       return;
@@ -355,14 +369,8 @@ void SelfContacts::findCandidates(const NodeArray& x)
     // diagonals) and only its nodes stay out of them; a cloth's (or jelly's) nodes within twice their
     // contact distance at rest (its direct and diagonal neighbours) are held apart by its springs, and come
     // that close only where it is crushed in its plane (Mueller's self-collision, Ten Minute Physics); a
-    // face-contact cloth's edges likewise (those two: rest_near_, marked for s).
-    if (marked != s)
-    {
-      mark(marked, 0);
-      mark(s, 1);
-      marked = s;
-    }
-    if (rest_near_mark_[t] != 0)
+    // face-contact cloth's edges likewise (those two: rest_near_).
+    if (nearAtRest(s, t))
       return;
     const double within = search_radius_[s] + search_radius_[t];
     if (a == b && c == d)
@@ -388,8 +396,8 @@ void SelfContacts::findCandidates(const NodeArray& x)
       return;
     candidates_.push_back({ static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t), distance });
   });
-  mark(marked, 0);
-  sortWithinRuns(candidates_, [](const Candidate& c) { return c.s; }, [](const Candidate& c) { return c.t; });
+  sortByGroups(candidates_, segments_.size(), [](const Candidate& c) { return c.s; },
+               [](const Candidate& c) { return c.t; }, found_, run_start_);
   findFaceCandidates(x);
   found_at_ = x;
   moved_.assign(static_cast<std::size_t>(x.cols()), 0.0);
@@ -407,6 +415,15 @@ void SelfContacts::gridSegments(const NodeArray& y, double reach)
     longest = std::max(longest, 2.0 * half_[s]);
   }
   grid_.build(middle_, half_, longest + reach + 1e-9);
+}
+
+bool SelfContacts::nearAtRest(std::size_t s, std::size_t t) const
+{
+  if (rest_near_start_.empty())
+    return false;
+  const std::uint32_t* first = rest_near_.data() + rest_near_start_[s];
+  const std::uint32_t* last = rest_near_.data() + rest_near_start_[s + 1];
+  return std::find(first, last, static_cast<std::uint32_t>(t)) != last;
 }
 
 bool SelfContacts::shareANode(std::size_t s, std::size_t t) const
@@ -431,20 +448,20 @@ void SelfContacts::findRestNeighbours()
   // At rest, in the arrays each search fills with the current positions.
   const double reach = 4.0 * largest_radius_;
   gridSegments(rest_, reach);
-  rest_near_start_.assign(segments_.size() + 1, 0);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
   grid_.forEachNearPair(reach, [&](std::size_t s, std::size_t t) {
     if (shareANode(s, t) || !kept_apart(s, t))
       return;
     double p, q;
     bool by_ends;
     if (contactGap(rest_, segments_[s], segments_[t], p, q, by_ends).norm() < 2.0 * (radius_[s] + radius_[t]))
-    {
-      rest_near_.push_back(static_cast<std::uint32_t>(t));
-      ++rest_near_start_[s + 1];
-    }
+      pairs.emplace_back(static_cast<std::uint32_t>(s), static_cast<std::uint32_t>(t));
   });
-  for (std::size_t s = 0; s < segments_.size(); ++s)
-    rest_near_start_[s + 1] += rest_near_start_[s];
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> scratch;
+  sortByGroups(pairs, segments_.size(), [](const auto& pair) { return pair.first; },
+               [](const auto& pair) { return pair.second; }, scratch, rest_near_start_);
+  for (const auto& pair : pairs)
+    rest_near_.push_back(pair.second);
 }
 
 void SelfContacts::findFaceCandidates(const NodeArray& x)

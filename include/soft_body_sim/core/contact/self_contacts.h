@@ -21,7 +21,8 @@ namespace soft_body_sim
 /// face's centroid and its farthest corner from it. With cells at least as wide as the two largest radii
 /// and the widest gap asked about, two balls within that gap of each other sit in the same or neighbouring
 /// cells. The cells that hold balls are numbered and found by their coordinates in a hash table, so that
-/// a query reads its 27 cells' balls and no others. Built by a counting sort each time, the balls copied
+/// a query reads its 27 cells' balls and no others, and a search for all near pairs each two neighbouring
+/// cells once. Built by a counting sort each time, the balls copied
 /// in the cells' order so that a cell's are read one after the other: no allocation once its arrays have
 /// grown to the ball count.
 class BallGrid
@@ -30,9 +31,9 @@ public:
   /// Sorts the balls (`centre` [m], one per column, and `radius` [m]) into cells of width `cell` [m] (> 0).
   void build(const NodeArray& centre, const std::vector<double>& radius, double cell);
 
-  /// Calls visit(s, t) for every pair s < t of balls closer than `gap` [m] to each other (their centres
-  /// closer than their radii and the gap, which must not exceed the cell's width less the two largest
-  /// radii), s ascending.
+  /// Calls visit(s, t) once for every pair s < t of balls closer than `gap` [m] to each other (their
+  /// centres closer than their radii and the gap, which must not exceed the cell's width less the two
+  /// largest radii), cell by cell: in no order of s or t.
   template <typename Visit>
   void forEachNearPair(double gap, Visit visit) const;
 
@@ -55,13 +56,16 @@ private:
   /// True if the cell numbered `cell` is the one at coordinates c.
   bool sameCell(std::uint32_t cell, const std::int32_t* c) const;
   std::int32_t coordinate(double position) const;
-  /// The numbers of the balls' cells among the 27 around (i, j, k), each once; their count.
-  int cellsAround(const std::int32_t* c, std::uint32_t* cells) const;
-  /// Calls visit(t) for every ball t of the `count` cells (cellsAround's) closer than `gap` to the ball
-  /// (p, r) with t > after (after = -1: all).
+  /// The cells around c (i, j, k) numbered 0 to 26 by their offsets (di, dj, dk), each -1, 0 or 1, in the
+  /// order of di, then dj, then dk; c's own is kOwnCell. The numbers of the balls' cells among those from
+  /// `first` on, each once; their count.
+  int cellsAround(const std::int32_t* c, int first, std::uint32_t* cells) const;
+  static constexpr int kOwnCell = 13;
+  /// Calls visit(t) for every ball t at the places [from[q], to[q]) of the sorted arrays, q < count,
+  /// closer than `gap` to the ball (p, r).
   template <typename Visit>
-  void visitCells(const std::uint32_t* cells, int count, const Vec3& p, double r, double gap, std::int64_t after,
-                  Visit visit) const;
+  void visitRanges(const std::uint32_t* from, const std::uint32_t* to, int count, const Vec3& p, double r,
+                   double gap, Visit visit) const;
 
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
   double cell_ = 1.0;                     ///< [m]
@@ -81,16 +85,15 @@ private:
 };
 
 template <typename Visit>
-void BallGrid::visitCells(const std::uint32_t* cells, int count, const Vec3& p, double r, double gap,
-                          std::int64_t after, Visit visit) const
+void BallGrid::visitRanges(const std::uint32_t* from, const std::uint32_t* to, int count, const Vec3& p, double r,
+                           double gap, Visit visit) const
 {
   // The arrays' starts held here: visit may write memory, which would have them read again for each ball.
   const std::uint32_t* sorted = sorted_.data();
   const double *x = x_.data(), *y = y_.data(), *z = z_.data(), *radius = r_.data();
-  // The balls after `after` tested without a branch, those that pass written to `found` and visited a
-  // batch at a time: whether a ball is near is a coin toss the processor cannot learn (mispredicted tests
-  // were most of a draping cloth's search). The same balls, in the same order, as visiting each as it is
-  // tested.
+  // The balls tested without a branch, those that pass written to `found` and visited a batch at a time:
+  // whether a ball is near is a coin toss the processor cannot learn (mispredicted tests were most of a
+  // draping cloth's search). The same balls, in the same order, as visiting each as it is tested.
   constexpr int kBatch = 64;
   std::uint32_t found[kBatch];
   int taken = 0;
@@ -100,15 +103,7 @@ void BallGrid::visitCells(const std::uint32_t* cells, int count, const Vec3& p, 
     taken = 0;
   };
   for (int q = 0; q < count; ++q)
-  {
-    // A cell's balls are in ascending order (build's counting sort): those after `after` are a tail, found
-    // by looking along the cell (a few balls) rather than by halving it.
-    std::size_t e = start_[cells[q]];
-    const std::size_t last = start_[cells[q] + 1];
-    if (after >= 0)
-      while (e < last && sorted[e] <= static_cast<std::uint32_t>(after))
-        ++e;
-    for (; e < last; ++e)
+    for (std::size_t e = from[q]; e < to[q]; ++e)
     {
       const double reach = r + radius[e] + gap;
       const double dx = x[e] - p.x(), dy = y[e] - p.y(), dz = z[e] - p.z();
@@ -117,26 +112,41 @@ void BallGrid::visitCells(const std::uint32_t* cells, int count, const Vec3& p, 
       if (taken == kBatch)
         visit_taken();
     }
-  }
   visit_taken();
 }
 
 template <typename Visit>
 void BallGrid::forEachNearPair(double gap, Visit visit) const
 {
-  const std::size_t count = cell_of_.size();
-  // The balls in their own order (s ascending), each read from the sorted arrays through its place; the
-  // cells around a ball looked up unless its predecessor's cell was the same (a rope's or a cloth row's
-  // next node, often).
-  std::uint32_t cells[27];
-  int around = 0;
-  for (std::size_t s = 0; s < count; ++s)
+  if (start_.empty())
+    return;
+  // Cell by cell, each ball against the later balls of its own cell and all those of the 13 cells after it
+  // (a half shell): each two neighbouring cells are looked at once, and the cells around are looked up once
+  // a cell, not once a ball (a ball's 27 probes of the hash table were about 30 % of a draping cloth's
+  // search in perf's profile).
+  const std::size_t cells = start_.size() - 1;
+  std::uint32_t later[kOwnCell];
+  std::uint32_t from[kOwnCell + 1], to[kOwnCell + 1];
+  for (std::size_t q = 0; q < cells; ++q)
   {
-    if (s == 0 || cell_of_[s] != cell_of_[s - 1])
-      around = cellsAround(&coordinate_[3 * s], cells);
-    const std::uint32_t e = place_[s];
-    visitCells(cells, around, Vec3(x_[e], y_[e], z_[e]), r_[e], gap, static_cast<std::int64_t>(s),
-               [&](std::size_t t) { visit(s, t); });
+    const int around = cellsAround(&cell_key_[3 * q], kOwnCell + 1, later);
+    for (int k = 0; k < around; ++k)
+    {
+      from[k + 1] = start_[later[k]];
+      to[k + 1] = start_[later[k] + 1];
+    }
+    to[0] = start_[q + 1];
+    for (std::uint32_t e = start_[q]; e < start_[q + 1]; ++e)
+    {
+      from[0] = e + 1;
+      const std::size_t s = sorted_[e];
+      visitRanges(from, to, around + 1, Vec3(x_[e], y_[e], z_[e]), r_[e], gap, [&](std::size_t t) {
+        if (s < t)
+          visit(s, t);
+        else
+          visit(t, s);
+      });
+    }
   }
 }
 
@@ -144,8 +154,14 @@ template <typename Visit>
 void BallGrid::forEachNear(const Vec3& centre, double radius, double gap, Visit visit) const
 {
   const std::int32_t c[3] = { coordinate(centre.x()), coordinate(centre.y()), coordinate(centre.z()) };
-  std::uint32_t cells[27];
-  visitCells(cells, cellsAround(c, cells), centre, radius, gap, -1, visit);
+  std::uint32_t cells[27], from[27], to[27];
+  const int count = cellsAround(c, 0, cells);
+  for (int q = 0; q < count; ++q)
+  {
+    from[q] = start_[cells[q]];
+    to[q] = start_[cells[q] + 1];
+  }
+  visitRanges(from, to, count, centre, radius, gap, visit);
 }
 
 /// Segment-against-segment contact of the bodies with `self_collision` (BodyRange); a body without links
@@ -181,8 +197,9 @@ public:
   std::size_t searches() const { return searches_; }
 
   /// Writes or reads the Verlet lists and what the passes keep from sub-step to sub-step
-  /// (state_archive.h); the links, faces and their radii are the scene's, and travel_, entry_, near_index_,
-  /// candidate_bound_ and live_ are each resolve's own, written before it reads them.
+  /// (state_archive.h); the links, faces and their radii are the scene's, travel_, entry_, near_index_,
+  /// candidate_bound_ and live_ are each resolve's own and found_ and run_start_ each search's, written
+  /// before they are read.
   void carry(StateArchive& archive)
   {
     archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, tick_,
@@ -234,6 +251,8 @@ private:
   void gridSegments(const NodeArray& y, double reach);
   /// True if segments s and t end on a common node (neighbours along a rope, a cloth's edges at a corner).
   bool shareANode(std::size_t s, std::size_t t) const;
+  /// True if segment t (s < t) is among s's neighbours at rest (rest_near_), which it never touches.
+  bool nearAtRest(std::size_t s, std::size_t t) const;
 
   /// The pairs of one body that its springs hold apart, their contact at rest within twice their radii:
   /// a cloth's or jelly's nodes (balls) and a face-contact cloth's edges, into rest_near_.
@@ -279,9 +298,6 @@ private:
   /// (findRestNeighbours): rest_near_[rest_near_start_[s] .. rest_near_start_[s + 1]); none without balls
   /// or face-contact cloths.
   std::vector<std::uint32_t> rest_near_start_, rest_near_;
-  /// per segment: 1 while the search looks at the pairs of a segment it is near at rest (a flag a pair
-  /// reads at once, in place of looking through the list)
-  std::vector<char> rest_near_mark_;
   /// A pair of links that may touch, and their least distance when found [m].
   struct Candidate
   {
@@ -293,6 +309,10 @@ private:
   /// The pairs that may touch, ordered by s and then t: the order the passes take the touching ones in,
   /// whatever the search (its grid, its skin) or how often it runs, so that none of that changes a bit.
   std::vector<Candidate> candidates_;
+  /// The search's own: the candidates as the grid finds them (in no order), and where each segment's run
+  /// of them begins once ordered (sortByGroups).
+  std::vector<Candidate> found_;
+  std::vector<std::uint32_t> run_start_;
   NodeArray found_at_;                         ///< positions when the candidates were found [m]
   /// per node (global index): how far it has moved since the candidates were found, relative to the
   /// colliding nodes' common motion (the middle of their displacements' bounding box) [m] (candidatesHold)
