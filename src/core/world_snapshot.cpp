@@ -13,7 +13,7 @@ namespace
 /// The bytes' first eight, and the format's version: a new carried value or a change of one's meaning
 /// makes a new version, which refuses the older bytes rather than misreading them.
 constexpr char kMagic[8] = { 's', 'b', 's', 'n', 'a', 'p', '\r', '\n' };
-constexpr std::uint32_t kFormatVersion = 5;
+constexpr std::uint32_t kFormatVersion = 6;
 /// Reads as itself only on a machine of the writer's byte order.
 constexpr std::uint32_t kByteOrder = 0x01020304;
 

@@ -173,9 +173,7 @@ void BallGrid::build(const NodeArray& centre, const std::vector<double>& radius,
     slots *= 2;
     --shift_;
   }
-  coordinate_.resize(3 * count);
   cell_of_.resize(count);
-  place_.resize(count);
   sorted_.resize(count);
   x_.resize(count);
   y_.resize(count);
@@ -187,7 +185,7 @@ void BallGrid::build(const NodeArray& centre, const std::vector<double>& radius,
   const std::size_t mask = slots - 1;
   for (std::size_t s = 0; s < count; ++s)
   {
-    std::int32_t* c = &coordinate_[3 * s];
+    std::int32_t c[3];
     for (int axis = 0; axis < 3; ++axis)
       c[axis] = coordinate(centre(axis, static_cast<Eigen::Index>(s)));
     std::size_t slot = slotOf(hashTerm(c[0], 0) ^ hashTerm(c[1], 1) ^ hashTerm(c[2], 2));
@@ -212,7 +210,6 @@ void BallGrid::build(const NodeArray& centre, const std::vector<double>& radius,
   for (std::size_t s = 0; s < count; ++s)
   {
     const std::uint32_t e = cursor_[cell_of_[s]]++;
-    place_[s] = e;
     sorted_[e] = static_cast<std::uint32_t>(s);
     x_[e] = centre(0, static_cast<Eigen::Index>(s));
     y_[e] = centre(1, static_cast<Eigen::Index>(s));

@@ -44,7 +44,7 @@ public:
 
   void carry(StateArchive& archive)
   {
-    archive(cell_, shift_, coordinate_, table_, cell_key_, start_, cell_of_, cursor_, place_, sorted_, x_, y_, z_, r_);
+    archive(cell_, shift_, table_, cell_key_, start_, cell_of_, cursor_, sorted_, x_, y_, z_, r_);
   }
 
 private:
@@ -68,9 +68,8 @@ private:
                    double gap, Visit visit) const;
 
   static constexpr std::uint32_t kEmpty = 0xffffffffu;
-  double cell_ = 1.0;                     ///< [m]
-  int shift_ = 63;                        ///< 64 less the bits of the table's size
-  std::vector<std::int32_t> coordinate_;  ///< per ball: its cell's i, j, k
+  double cell_ = 1.0;  ///< [m]
+  int shift_ = 63;     ///< 64 less the bits of the table's size
   /// A hash table with linear probing, at most half full: per slot, the number of a cell that has balls,
   /// or kEmpty. Only a cell's own balls are read, not those of cells that share its hash.
   std::vector<std::uint32_t> table_;
@@ -78,7 +77,6 @@ private:
   std::vector<std::uint32_t> start_;    ///< per cell: where its balls begin in the sorted arrays
   std::vector<std::uint32_t> cell_of_;  ///< per ball: its cell's number
   std::vector<std::uint32_t> cursor_;   ///< per cell: the next free place while sorting
-  std::vector<std::uint32_t> place_;    ///< per ball: its place in the sorted arrays
   /// the balls in cell order: index, centre [m] and radius [m]
   std::vector<std::uint32_t> sorted_;
   std::vector<double> x_, y_, z_, r_;
