@@ -42,11 +42,6 @@ public:
   template <typename Visit>
   void forEachNear(const Vec3& centre, double radius, double gap, Visit visit) const;
 
-  void carry(StateArchive& archive)
-  {
-    archive(cell_, shift_, table_, cell_key_, start_, cell_of_, cursor_, sorted_, x_, y_, z_, r_);
-  }
-
 private:
   /// Cell coordinate i's term of the hash along `axis` (Teschner et al.'s primes): a cell's slot is made
   /// from the three's exclusive or (slotOf).
@@ -196,12 +191,12 @@ public:
 
   /// Writes or reads the Verlet lists and what the passes keep from sub-step to sub-step
   /// (state_archive.h); the links, faces and their radii are the scene's, travel_, entry_, near_index_,
-  /// candidate_bound_ and live_ are each resolve's own and found_ and run_start_ each search's, written
-  /// before they are read.
+  /// candidate_bound_ and live_ are each resolve's own, and found_, run_start_, the balls (middle_, half_,
+  /// face_centre_, face_extent_) and the grids each search's, written before they are read.
   void carry(StateArchive& archive)
   {
-    archive(start_, skin_, middle_, half_, grid_, candidates_, found_at_, moved_, searches_, near_, moved_at_, tick_,
-            face_centre_, face_extent_, face_grid_, face_candidates_, near_faces_);
+    archive(start_, skin_, candidates_, found_at_, moved_, searches_, near_, moved_at_, tick_, face_candidates_,
+            near_faces_);
   }
 
   /// Two links of one body whose first nodes are this many places apart or fewer never collide: a rope
